@@ -1,0 +1,43 @@
+# Developer entry points. scripts/test.sh and scripts/demo.sh install the Debian packages first;
+# these targets assume they are present (run `bash scripts/install_deps.sh` once).
+JOBS ?= $(shell nproc)
+BUILD ?= build
+SANITIZE_BUILD ?= build-sanitize
+BENCH_BUILD ?= build-release
+
+.PHONY: all build test test-sanitize demo bench install-check format clean
+
+all: build
+
+$(BUILD)/CMakeCache.txt:
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo
+
+build: $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS)
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# The tests under AddressSanitizer + UndefinedBehaviorSanitizer.
+test-sanitize:
+	cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Debug -DEXTWRENCH_SANITIZE=ON \
+	  -DCMAKE_CXX_FLAGS="-O1" -DEXTWRENCH_BUILD_EXAMPLES=OFF
+	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
+	cd $(SANITIZE_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS)
+
+demo: build
+	$(BUILD)/extwrench simulate scenarios/paper.yaml --out results/paper
+
+bench:
+	cmake -S . -B $(BENCH_BUILD) -DCMAKE_BUILD_TYPE=Release -DEXTWRENCH_BUILD_BENCHMARKS=ON \
+	  -DEXTWRENCH_BUILD_TESTS=OFF
+	cmake --build $(BENCH_BUILD) -j $(JOBS) --target extwrench_bench extwrench_cli
+	$(BENCH_BUILD)/benchmarks/extwrench_bench --benchmark_out=$(BUILD)/bench.json \
+	  --benchmark_out_format=json --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+
+format:
+	clang-format -i $$(git ls-files '*.hpp' '*.cpp')
+
+clean:
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(BENCH_BUILD)

@@ -1,0 +1,84 @@
+// Basic linear-algebra types and small spatial helpers shared by every module.
+//
+// Conventions (stated once, see docs/conventions.md):
+//  - 6D vectors are ordered [linear; angular], as F/T sensors, Pinocchio and KDL do.
+//  - A Pose X_AB maps coordinates in frame B to frame A: p_A = R_AB p_B + p_AB.
+//  - Spatial quantities in dynamics::Data are expressed in the world (root) frame, about the
+//    world origin, unless their name says otherwise.
+#pragma once
+
+#include <cmath>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace extwrench {
+
+using Vector3 = Eigen::Vector3d;
+using Vector6 = Eigen::Matrix<double, 6, 1>;
+using Matrix3 = Eigen::Matrix3d;
+using Matrix6 = Eigen::Matrix<double, 6, 6>;
+using VectorX = Eigen::VectorXd;
+using MatrixX = Eigen::MatrixXd;
+using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
+using Matrix3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+
+/// Skew-symmetric matrix S(v) such that S(v) w = v × w.
+inline Matrix3 skew(const Vector3& v) {
+  Matrix3 s;
+  s << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return s;
+}
+
+/// Rigid transform X_AB (pose of frame B in frame A).
+struct Pose {
+  Matrix3 rotation = Matrix3::Identity();  ///< R_AB
+  Vector3 translation = Vector3::Zero();    ///< p_AB: origin of B in A
+
+  static Pose identity() { return {}; }
+
+  /// URDF convention: fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)).
+  static Pose from_xyz_rpy(const Vector3& xyz, const Vector3& rpy) {
+    Pose x;
+    x.rotation = (Eigen::AngleAxisd(rpy.z(), Vector3::UnitZ()) *
+                  Eigen::AngleAxisd(rpy.y(), Vector3::UnitY()) *
+                  Eigen::AngleAxisd(rpy.x(), Vector3::UnitX()))
+                     .toRotationMatrix();
+    x.translation = xyz;
+    return x;
+  }
+
+  /// X_AC = X_AB * X_BC
+  Pose operator*(const Pose& other) const {
+    Pose x;
+    x.rotation.noalias() = rotation * other.rotation;
+    x.translation.noalias() = rotation * other.translation;
+    x.translation += translation;
+    return x;
+  }
+
+  /// Point given in B, returned in A.
+  Vector3 act(const Vector3& p_B) const { return rotation * p_B + translation; }
+
+  Pose inverse() const {
+    Pose x;
+    x.rotation = rotation.transpose();
+    x.translation.noalias() = -(x.rotation * translation);
+    return x;
+  }
+
+  bool is_approx(const Pose& other, double tol = 1e-12) const {
+    return rotation.isApprox(other.rotation, tol) &&
+           (translation - other.translation).norm() <= tol * (1.0 + translation.norm());
+  }
+};
+
+/// Rotation matrix to fixed-axis roll, pitch, yaw (URDF convention).
+inline Vector3 rpy_from_rotation(const Matrix3& r) {
+  const double pitch = std::atan2(-r(2, 0), std::hypot(r(0, 0), r(1, 0)));
+  const double roll = std::atan2(r(2, 1), r(2, 2));
+  const double yaw = std::atan2(r(1, 0), r(0, 0));
+  return {roll, pitch, yaw};
+}
+
+}  // namespace extwrench

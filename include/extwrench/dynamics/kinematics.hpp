@@ -1,0 +1,26 @@
+// Forward kinematics and Jacobians.
+#pragma once
+
+#include "extwrench/dynamics/data.hpp"
+
+namespace extwrench {
+
+/// Poses of all bodies (data.X_WB), joint motion subspaces (data.S) and world-frame mass
+/// properties. q: (n). Every other algorithm calls it first.
+void forward_kinematics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q);
+
+/// Pose of a named frame in the world, after forward_kinematics.
+[[nodiscard]] Pose frame_pose(const Model& model, const Data& data, int frame);
+
+/// Jacobian of a point rigidly attached to body `body`, after forward_kinematics:
+/// J (6 x n) = [J_v; J_w], J_v maps q_dot to the point's linear velocity, J_w to the body's
+/// angular velocity, both in world-aligned axes (the point is p_W, given in the world frame).
+/// Columns of joints that are not ancestors of the body are zero. Writes into `J`, which must
+/// be 6 x n (no allocation).
+void point_jacobian(const Model& model, const Data& data, int body, const Vector3& p_W,
+                    Eigen::Ref<Matrix6X> J);
+
+/// Jacobian of the body frame's origin (point_jacobian at the body origin), into data.J.
+const Matrix6X& body_jacobian(const Model& model, Data& data, int body);
+
+}  // namespace extwrench

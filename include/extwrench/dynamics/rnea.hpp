@@ -1,0 +1,49 @@
+// Recursive Newton-Euler with external wrenches and the base iteration (SPEC section 3).
+#pragma once
+
+#include <span>
+
+#include "extwrench/dynamics/data.hpp"
+
+namespace extwrench {
+
+/// An external wrench acting on a body: a force applied at a point plus a pure moment,
+/// all in the world frame.
+struct ExternalWrench {
+  int body = 0;                      ///< index of the body it acts on (0 = link 0)
+  Vector3 force_W = Vector3::Zero(); ///< F_ext [N]
+  Vector3 point_W = Vector3::Zero(); ///< application point p [m]
+  Vector3 moment_W = Vector3::Zero();///< pure moment M_ext [N m]
+};
+
+/// Inverse dynamics tau = B(q) ddq + C(q, dq) dq + g(q) - sum_k J_k^T W_k, eqs. (7)-(12),
+/// iterated down to link 0: data.root_wrench_W is f_0 (the wrench the ground applies to link 0,
+/// about the world origin, link 0's own weight included). Runs forward_kinematics.
+/// q, dq, ddq: (n). Returns data.tau.
+const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                    const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& ddq,
+                    std::span<const ExternalWrench> external = {});
+
+/// As rnea, but after forward_kinematics was already run for this q (saves the pose pass).
+const VectorX& rnea_no_kinematics(const Model& model, Data& data,
+                                  const Eigen::Ref<const VectorX>& dq,
+                                  const Eigen::Ref<const VectorX>& ddq,
+                                  std::span<const ExternalWrench> external = {},
+                                  bool with_gravity = true);
+
+/// What the robot discharges onto a base sensor at pose X_WS (SPEC 3: f_m = -f_0, n_m = -n_0
+/// about O_s), in the sensor frame: [f_m; n_m], moment about the sensor origin. Uses
+/// data.root_wrench_W from the last rnea.
+[[nodiscard]] Vector6 sensor_reading(const Data& data, const Pose& X_WS);
+
+/// The same reading expressed in the world frame (moment still about O_s).
+[[nodiscard]] Vector6 sensor_reading_world(const Data& data, const Vector3& p_WS);
+
+/// Bias torques c(q, dq) = C(q, dq) dq + g(q) into data.tau.
+const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                            const Eigen::Ref<const VectorX>& dq);
+
+/// Gravity torques g(q) into data.gravity_torque.
+const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q);
+
+}  // namespace extwrench

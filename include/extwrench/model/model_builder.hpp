@@ -1,0 +1,75 @@
+// Builds a validated Model from URDF-like links and joints (tree, fixed joints allowed).
+// Parsers (io/) fill the specs; every spec carries a `source` string ("file.urdf:42") that
+// each error message starts with, so errors name the file and line of the offending element.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "extwrench/model/model.hpp"
+
+namespace extwrench {
+
+struct LinkSpec {
+  std::string name;
+  Inertia inertia;       ///< in the link frame (URDF <inertial> already applied)
+  std::string source;    ///< where it was defined, for error messages, e.g. "robot.urdf:12"
+};
+
+enum class JointSpecType { kRevolute, kContinuous, kPrismatic, kFixed };
+
+struct JointSpec {
+  std::string name;
+  JointSpecType type = JointSpecType::kRevolute;
+  std::string parent;    ///< parent link name
+  std::string child;     ///< child link name
+  Pose origin;           ///< X_{parent link, child link} at q = 0
+  Vector3 axis = Vector3::UnitX();  ///< URDF default axis (1, 0, 0); need not be unit, not zero
+  double lower = -std::numeric_limits<double>::infinity();
+  double upper = std::numeric_limits<double>::infinity();
+  double velocity_limit = std::numeric_limits<double>::infinity();
+  double effort_limit = std::numeric_limits<double>::infinity();
+  double damping = 0.0;
+  double friction = 0.0;
+  std::string source;
+};
+
+/// Extra named frame attached to a link (e.g. a DH frame or a tool point).
+struct FrameSpec {
+  std::string name;
+  std::string link;
+  Pose placement;        ///< X_{link, frame}
+  std::string source;
+};
+
+class ModelBuilder {
+ public:
+  void set_name(std::string name) { name_ = std::move(name); }
+  void set_gravity(const Vector3& g) { gravity_ = g; }
+  void add_link(LinkSpec link) { links_.push_back(std::move(link)); }
+  void add_joint(JointSpec joint) { joints_.push_back(std::move(joint)); }
+  void add_frame(FrameSpec frame) { frames_.push_back(std::move(frame)); }
+
+  /// Validates everything (see validate_inertia and docs/model.md) and builds the Model:
+  /// fixed joints merged into the parent body, bodies in topological (depth-first) order,
+  /// a Frame for every link. Throws extwrench::Error naming source, element and field.
+  [[nodiscard]] Model build() const;
+
+ private:
+  std::string name_;
+  Vector3 gravity_{0.0, 0.0, -9.81};
+  std::vector<LinkSpec> links_;
+  std::vector<JointSpec> joints_;
+  std::vector<FrameSpec> frames_;
+};
+
+/// Throws extwrench::Error (prefixed by `where`) when mass properties are not physical:
+/// non-finite entries, negative mass, non-symmetric or not positive semi-definite inertia,
+/// or principal moments violating the triangle inequality.
+void validate_inertia(const Inertia& inertia, const std::string& where);
+
+/// Checks a built model: finite numbers, unit axes, limits, and that the joint-space mass
+/// matrix is positive definite at q = 0 (zero-mass bodies are fine only then).
+void validate_model(const Model& model);
+
+}  // namespace extwrench

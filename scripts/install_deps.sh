@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages extwrench needs, only those missing. Safe to run again.
+set -euo pipefail
+packages=(
+  build-essential cmake make git pkg-config
+  libeigen3-dev libtinyxml2-dev libyaml-cpp-dev libcli11-dev libassimp-dev libembree-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  liborocos-kdl-dev libkdl-parser-dev libmujoco-dev
+  gnuplot-nox
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "extwrench: installing missing Debian packages: ${missing[*]}"
+  sudo_cmd=""
+  if [ "$(id -u)" -ne 0 ]; then sudo_cmd="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $sudo_cmd apt-get update -qq
+  $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
