@@ -42,6 +42,11 @@ struct Data {
   Matrix6X J;                       ///< (6 x n) last Jacobian computed
 
   // --- scratch ---
+  // Composite mass properties of each subtree about the world origin: (m, h, I_O) add up
+  // directly since every body's are expressed at the same point in the same axes.
+  std::vector<double> composite_mass;
+  std::vector<Vector3> composite_first_moment;
+  std::vector<Matrix3> composite_inertia_O;
   std::vector<Matrix6> Ic;          ///< composite spatial inertia of each subtree (world, origin)
   std::vector<Matrix6> Bc;          ///< composite v x* I of each subtree (for C)
   std::vector<Vector6> Sdot;        ///< time derivative of S

@@ -1,0 +1,124 @@
+#include "extwrench/dynamics/crba.hpp"
+
+#include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "spatial.hpp"
+
+namespace extwrench {
+
+const MatrixX& crba_no_kinematics(const Model& model, Data& data) {
+  const int nb = model.num_bodies();
+  for (int i = 0; i < nb; ++i) {
+    data.composite_mass[i] = data.mass[i];
+    data.composite_first_moment[i] = data.first_moment_W[i];
+    data.composite_inertia_O[i] = data.inertia_O_W[i];
+  }
+  for (int i = nb - 1; i > 0; --i) {
+    const double m = data.composite_mass[i];
+    const Vector3& h = data.composite_first_moment[i];
+    const Matrix3& I_O = data.composite_inertia_O[i];
+    const Vector6 F = detail::inertia_times(m, h, I_O, data.S[i]);
+    // M_ij = S_j^T Ic_i S_i for j = i and every ancestor j of i.
+    for (int j = i; j > 0; j = model.parents[j]) {
+      const double mij = data.S[j].dot(F);
+      data.M(i - 1, j - 1) = mij;
+      data.M(j - 1, i - 1) = mij;
+    }
+    const int p = model.parents[i];
+    data.composite_mass[p] += m;
+    data.composite_first_moment[p] += h;
+    data.composite_inertia_O[p] += I_O;
+  }
+  return data.M;
+}
+
+const MatrixX& crba(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  forward_kinematics(model, data, q);
+  return crba_no_kinematics(model, data);
+}
+
+const MatrixX& coriolis_matrix(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                               const Eigen::Ref<const VectorX>& dq) {
+  forward_kinematics(model, data, q);
+  const int nb = model.num_bodies();
+  data.v[0].setZero();
+  for (int i = 1; i < nb; ++i) {
+    data.v[i] = data.v[model.parents[i]] + data.S[i] * dq[i - 1];
+    data.Sdot[i] = detail::cross_motion(data.v[i], data.S[i]);
+  }
+  for (int i = 0; i < nb; ++i) {
+    data.Ic[i] = detail::inertia_matrix(data.mass[i], data.first_moment_W[i], data.inertia_O_W[i]);
+    data.Bc[i] = detail::cross_force_matrix(data.v[i]) * data.Ic[i];
+  }
+  data.C.setZero();
+  // C = sum_k J_k^T (I_k J_dot_k + (v_k x*) I_k J_k), so that B_dot = C + C^T. With composites
+  // Ic_i, Bc_i over the subtree of i, for every ancestor j of i (j = i included):
+  //   C_ij = S_i^T (Ic_i S_dot_j + Bc_i S_j),  C_ji = S_j^T (Ic_i S_dot_i + Bc_i S_i).
+  for (int i = nb - 1; i > 0; --i) {
+    const Vector6 Fi = data.Ic[i] * data.Sdot[i] + data.Bc[i] * data.S[i];
+    const Vector6 Si_Ic = data.Ic[i].transpose() * data.S[i];
+    const Vector6 Si_Bc = data.Bc[i].transpose() * data.S[i];
+    for (int j = i; j > 0; j = model.parents[j]) {
+      data.C(i - 1, j - 1) = Si_Ic.dot(data.Sdot[j]) + Si_Bc.dot(data.S[j]);
+      data.C(j - 1, i - 1) = data.S[j].dot(Fi);
+    }
+    const int p = model.parents[i];
+    data.Ic[p] += data.Ic[i];
+    data.Bc[p] += data.Bc[i];
+  }
+  return data.C;
+}
+
+void momentum_terms_no_kinematics(const Model& model, Data& data,
+                                  const Eigen::Ref<const VectorX>& dq) {
+  const int nb = model.num_bodies();
+  const Vector3& g = model.gravity;
+  data.v[0].setZero();
+  for (int i = 1; i < nb; ++i) data.v[i] = data.v[model.parents[i]] + data.S[i] * dq[i - 1];
+  // Backward accumulation over subtrees, reusing f as the subtree momentum H_i.
+  for (int i = 0; i < nb; ++i) {
+    data.h[i] = detail::inertia_times(data.mass[i], data.first_moment_W[i], data.inertia_O_W[i],
+                                      data.v[i]);
+    data.f[i] = data.h[i];  // H_i = sum of h_k over sub(i)
+    data.composite_mass[i] = data.mass[i];
+    data.composite_first_moment[i] = data.first_moment_W[i];
+  }
+  for (int i = nb - 1; i > 0; --i) {
+    const int p = model.parents[i];
+    const Vector6& s = data.S[i];
+    // p_i = S_i^T H_i  (generalized momentum B q_dot)
+    data.momentum[i - 1] = s.dot(data.f[i]);
+    // (C^T q_dot)_i = dT/dq_i. Moving joint i rotates the whole subtree: with world-frame
+    // inertias dI_k/dq_i = S_i x* I_k - I_k S_i x, and dv_k/dq_i = S_i x (v_k - v_p); the
+    // v_k terms cancel, leaving dT/dq_i = -S_i^T (v_p x* H_i).
+    data.coriolis_transpose_dq[i - 1] = -s.dot(detail::cross_force(data.v[p], data.f[i]));
+    // g_i = S_i^T [-m_c g; -h_c x g]  (composite weight of the subtree)
+    const double mc = data.composite_mass[i];
+    const Vector3& hc = data.composite_first_moment[i];
+    data.gravity_torque[i - 1] = -(s.head<3>().dot(mc * g) + s.tail<3>().dot(hc.cross(g)));
+    data.f[p] += data.f[i];
+    data.composite_mass[p] += mc;
+    data.composite_first_moment[p] += hc;
+  }
+}
+
+void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                    const Eigen::Ref<const VectorX>& dq) {
+  forward_kinematics(model, data, q);
+  momentum_terms_no_kinematics(model, data, dq);
+}
+
+bool forward_dynamics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                      const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau) {
+  forward_kinematics(model, data, q);
+  crba_no_kinematics(model, data);
+  data.tmp_n.setZero();
+  rnea_no_kinematics(model, data, dq, data.tmp_n, {}, true);
+  data.mass_llt.compute(data.M);
+  if (data.mass_llt.info() != Eigen::Success) return false;
+  data.ddq = tau - data.tau;
+  data.mass_llt.solveInPlace(data.ddq);
+  return true;
+}
+
+}  // namespace extwrench

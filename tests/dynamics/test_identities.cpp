@@ -1,0 +1,282 @@
+// Physical and algebraic identities of the dynamics on random serial chains and trees:
+// every algorithm checked against another path (finite differences, RNEA columns, Newton's law).
+#include <gtest/gtest.h>
+
+#include "extwrench/dynamics/crba.hpp"
+#include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "support/random_model.hpp"
+
+namespace extwrench {
+namespace {
+
+using test::RandomModelOptions;
+using test::SeededRng;
+
+// Central differences with step 1e-6 have truncation error ~1e-12 * third derivative and
+// round-off ~1e-16 / 1e-6: 1e-7 relative is a comfortable bound for these smooth functions.
+constexpr double kFiniteDifferenceTol = 1e-7;
+constexpr double kFdStep = 1e-6;
+// Algebraic identities that only reorder floating-point operations.
+constexpr double kAlgebraicTol = 1e-10;
+constexpr int kStates = 200;
+
+struct Case {
+  const char* name;
+  RandomModelOptions options;
+};
+
+class DynamicsIdentities : public ::testing::TestWithParam<Case> {
+ protected:
+  void SetUp() override { model_ = test::random_model(GetParam().options); }
+  Model model_;
+};
+
+double scale(const MatrixX& m) { return std::max(1.0, m.cwiseAbs().maxCoeff()); }
+
+TEST_P(DynamicsIdentities, MassMatrixDerivativeEqualsCPlusCTranspose) {
+  Data data(model_);
+  SeededRng rng(11);
+  const int n = model_.nq();
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    const MatrixX m_plus = crba(model_, data, q + kFdStep * dq);
+    const MatrixX m_minus = crba(model_, data, q - kFdStep * dq);
+    const MatrixX b_dot = (m_plus - m_minus) / (2 * kFdStep);
+    const MatrixX c = coriolis_matrix(model_, data, q, dq);
+    EXPECT_LE((b_dot - c - c.transpose()).cwiseAbs().maxCoeff(), kFiniteDifferenceTol * scale(b_dot));
+  }
+}
+
+TEST_P(DynamicsIdentities, CoriolisTimesVelocityPlusGravityEqualsBiasTorques) {
+  Data data(model_);
+  SeededRng rng(12);
+  const int n = model_.nq();
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    const VectorX c_dq = coriolis_matrix(model_, data, q, dq) * dq;
+    const VectorX g = gravity_torques(model_, data, q);
+    const VectorX bias = bias_torques(model_, data, q, dq);
+    EXPECT_LE((c_dq + g - bias).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(bias));
+  }
+}
+
+TEST_P(DynamicsIdentities, CoriolisTransposeTimesVelocityEqualsKineticEnergyGradient) {
+  Data data(model_);
+  SeededRng rng(13);
+  const int n = model_.nq();
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    VectorX dT(n);
+    for (int i = 0; i < n; ++i) {
+      VectorX qp = q, qm = q;
+      qp[i] += kFdStep;
+      qm[i] -= kFdStep;
+      const double tp = 0.5 * dq.dot(crba(model_, data, qp) * dq);
+      const double tm = 0.5 * dq.dot(crba(model_, data, qm) * dq);
+      dT[i] = (tp - tm) / (2 * kFdStep);
+    }
+    momentum_terms(model_, data, q, dq);
+    const VectorX ctdq = data.coriolis_transpose_dq;
+    EXPECT_LE((ctdq - dT).cwiseAbs().maxCoeff(), kFiniteDifferenceTol * scale(dT));
+    const VectorX c_explicit = coriolis_matrix(model_, data, q, dq).transpose() * dq;
+    EXPECT_LE((ctdq - c_explicit).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(c_explicit));
+  }
+}
+
+TEST_P(DynamicsIdentities, MomentumTermsMatchMassMatrixAndGravity) {
+  Data data(model_);
+  SeededRng rng(14);
+  const int n = model_.nq();
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    const VectorX b_dq = crba(model_, data, q) * dq;
+    const VectorX g = gravity_torques(model_, data, q);
+    momentum_terms(model_, data, q, dq);
+    EXPECT_LE((data.momentum - b_dq).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(b_dq));
+    EXPECT_LE((data.gravity_torque - g).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(g));
+  }
+}
+
+TEST_P(DynamicsIdentities, MassMatrixEqualsRneaColumns) {
+  Data data(model_);
+  SeededRng rng(15);
+  const int n = model_.nq();
+  const VectorX zero = VectorX::Zero(n);
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3);
+    const MatrixX m = crba(model_, data, q);
+    const VectorX g = rnea(model_, data, q, zero, zero);
+    for (int i = 0; i < n; ++i) {
+      const VectorX column = rnea(model_, data, q, zero, VectorX::Unit(n, i)) - g;
+      EXPECT_LE((m.col(i) - column).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(m));
+    }
+    EXPECT_GT(Eigen::LLT<MatrixX>(m).info() == Eigen::Success, 0);
+  }
+}
+
+TEST_P(DynamicsIdentities, ForwardDynamicsInvertsRnea) {
+  Data data(model_);
+  SeededRng rng(16);
+  const int n = model_.nq();
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    const VectorX ddq = rng.uniform_vector(n, -5, 5);
+    const VectorX tau = rnea(model_, data, q, dq, ddq);
+    ASSERT_TRUE(forward_dynamics(model_, data, q, dq, tau));
+    EXPECT_LE((data.ddq - ddq).cwiseAbs().maxCoeff(), 1e-8 * scale(ddq));
+  }
+}
+
+TEST_P(DynamicsIdentities, ExternalWrenchEntersAsJacobianTranspose) {
+  Data data(model_);
+  SeededRng rng(17);
+  const int n = model_.nq();
+  Matrix6X J(6, n);
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    const VectorX ddq = rng.uniform_vector(n, -5, 5);
+    const VectorX tau_free = rnea(model_, data, q, dq, ddq);
+    ExternalWrench w;
+    w.body = 1 + k % n;
+    w.force_W = rng.uniform_vector3(-20, 20);
+    w.moment_W = rng.uniform_vector3(-5, 5);
+    w.point_W = data.X_WB[w.body].act(rng.uniform_vector3(-0.2, 0.2));
+    const VectorX tau_ext = rnea(model_, data, q, dq, ddq, std::span(&w, 1));
+    point_jacobian(model_, data, w.body, w.point_W, J);
+    Vector6 wrench;
+    wrench << w.force_W, w.moment_W;
+    const VectorX expected = tau_free - J.transpose() * wrench;
+    EXPECT_LE((tau_ext - expected).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(expected));
+  }
+}
+
+TEST_P(DynamicsIdentities, PointJacobianMatchesFiniteDifferencesOfKinematics) {
+  Data data(model_);
+  SeededRng rng(18);
+  const int n = model_.nq();
+  Matrix6X J(6, n);
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    const int body = 1 + k % n;
+    const Vector3 p_B = rng.uniform_vector3(-0.2, 0.2);
+    forward_kinematics(model_, data, q + kFdStep * dq);
+    const Pose plus = data.X_WB[body];
+    forward_kinematics(model_, data, q - kFdStep * dq);
+    const Pose minus = data.X_WB[body];
+    forward_kinematics(model_, data, q);
+    point_jacobian(model_, data, body, data.X_WB[body].act(p_B), J);
+    const Vector6 twist = J * dq;
+    const Vector3 v_fd = (plus.act(p_B) - minus.act(p_B)) / (2 * kFdStep);
+    // R_dot R^T = S(w)
+    const Matrix3 w_hat = (plus.rotation - minus.rotation) / (2 * kFdStep) *
+                          data.X_WB[body].rotation.transpose();
+    const Vector3 w_fd(w_hat(2, 1), w_hat(0, 2), w_hat(1, 0));
+    EXPECT_LE((twist.head<3>() - v_fd).norm(), kFiniteDifferenceTol * (1 + v_fd.norm()));
+    EXPECT_LE((twist.tail<3>() - w_fd).norm(), kFiniteDifferenceTol * (1 + w_fd.norm()));
+  }
+}
+
+// Newton-Euler for the whole robot, an independent path to the base reading:
+// f_m = sum F_ext + M g - P_dot and n_m = sum (M_ext + (p - O_s) x F_ext) + (c - O_s) x M g - L_dot
+// (L about the fixed point O_s), with P and L from the bodies' velocities and P_dot, L_dot by
+// central differences along the motion.
+struct Momenta {
+  Vector3 linear, angular_about_sensor;
+};
+
+Momenta robot_momenta(const Model& model, Data& data, const VectorX& q, const VectorX& dq,
+                      const Vector3& p_WS) {
+  forward_kinematics(model, data, q);
+  Momenta out{Vector3::Zero(), Vector3::Zero()};
+  Matrix6X J(6, model.nq());
+  for (int i = 1; i < model.num_bodies(); ++i) {
+    const Inertia& in = model.bodies[i].inertia;
+    const Vector3 c_W = data.X_WB[i].act(in.com);
+    point_jacobian(model, data, i, c_W, J);
+    const Vector6 twist = J * dq;
+    const Vector3 p = in.mass * twist.head<3>();
+    const Matrix3 R = data.X_WB[i].rotation;
+    out.linear += p;
+    out.angular_about_sensor += (c_W - p_WS).cross(p) + R * in.inertia_com * R.transpose() * twist.tail<3>();
+  }
+  return out;
+}
+
+TEST_P(DynamicsIdentities, BaseReadingObeysNewtonEulerForTheWholeRobot) {
+  Data data(model_);
+  SeededRng rng(19);
+  const int n = model_.nq();
+  const double h = 1e-5;
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    const VectorX ddq = rng.uniform_vector(n, -5, 5);
+    const Pose X_WS = Pose::from_xyz_rpy(rng.uniform_vector3(-0.5, 0.5), rng.uniform_vector3(-3, 3));
+    ExternalWrench w;
+    w.body = k % (n + 1);
+    w.force_W = rng.uniform_vector3(-20, 20);
+    w.moment_W = rng.uniform_vector3(-5, 5);
+    // Along q(t) with the given dq, ddq: second-order Taylor, so the central difference of the
+    // momenta at t = 0 is exact to O(h^2).
+    const Momenta plus = robot_momenta(model_, data, q + h * dq + 0.5 * h * h * ddq, dq + h * ddq, X_WS.translation);
+    const Momenta minus = robot_momenta(model_, data, q - h * dq + 0.5 * h * h * ddq, dq - h * ddq, X_WS.translation);
+    const Vector3 p_dot = (plus.linear - minus.linear) / (2 * h);
+    const Vector3 l_dot = (plus.angular_about_sensor - minus.angular_about_sensor) / (2 * h);
+
+    forward_kinematics(model_, data, q);
+    w.point_W = data.X_WB[w.body].act(rng.uniform_vector3(-0.2, 0.2));
+    double total_mass = 0;
+    Vector3 first_moment = Vector3::Zero();
+    for (int i = 0; i <= n; ++i) {
+      total_mass += data.mass[i];
+      first_moment += data.first_moment_W[i];
+    }
+    const Vector3 com = first_moment / total_mass;
+    rnea(model_, data, q, dq, ddq, std::span(&w, 1));
+    const Vector6 reading_W = sensor_reading_world(data, X_WS.translation);
+    const Vector6 reading_S = sensor_reading(data, X_WS);
+
+    const Vector3 weight = total_mass * model_.gravity;
+    const Vector3 f_expected = w.force_W + weight - p_dot;
+    const Vector3 n_expected = w.moment_W + (w.point_W - X_WS.translation).cross(w.force_W) +
+                               (com - X_WS.translation).cross(weight) - l_dot;
+    EXPECT_LE((reading_W.head<3>() - f_expected).norm(), 1e-6 * (1 + f_expected.norm()));
+    EXPECT_LE((reading_W.tail<3>() - n_expected).norm(), 1e-6 * (1 + n_expected.norm()));
+    EXPECT_LE((X_WS.rotation * reading_S.head<3>() - reading_W.head<3>()).norm(), 1e-12 * (1 + f_expected.norm()));
+    EXPECT_LE((X_WS.rotation * reading_S.tail<3>() - reading_W.tail<3>()).norm(), 1e-12 * (1 + n_expected.norm()));
+  }
+}
+
+TEST_P(DynamicsIdentities, StaticRobotDischargesItsWeightAndItsMoment) {
+  Data data(model_);
+  SeededRng rng(20);
+  const int n = model_.nq();
+  const VectorX zero = VectorX::Zero(n);
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3);
+    rnea(model_, data, q, zero, zero);
+    // Independent centre of mass: from the model's inertias and the body poses.
+    double m = 0;
+    Vector3 mc = Vector3::Zero();
+    for (int i = 0; i <= n; ++i) {
+      const Inertia& in = model_.bodies[i].inertia;
+      m += in.mass;
+      mc += in.mass * data.X_WB[i].act(in.com);
+    }
+    const Vector3 p_WS(0.1, -0.2, -0.3);
+    const Vector6 reading = sensor_reading_world(data, p_WS);
+    const Vector3 weight = m * model_.gravity;
+    EXPECT_LE((reading.head<3>() - weight).norm(), 1e-12 * weight.norm());
+    EXPECT_LE((reading.tail<3>() - (mc / m - p_WS).cross(weight)).norm(), 1e-12 * weight.norm());
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    RandomModels, DynamicsIdentities,
+    ::testing::Values(Case{"Chain7", {7, false, false, 1}}, Case{"Tree9", {9, true, false, 2}},
+                      Case{"ChainWithPrismatic6", {6, false, true, 3}},
+                      Case{"TreeWithPrismatic8", {8, true, true, 4}}),
+    [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace extwrench
