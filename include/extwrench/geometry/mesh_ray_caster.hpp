@@ -1,0 +1,33 @@
+// Acceleration structure for line queries on a triangle mesh. The core library only sees this
+// interface; the io library implements it with Embree (make_embree_ray_caster, io/mesh.hpp).
+#pragma once
+
+#include "extwrench/core/types.hpp"
+
+namespace extwrench {
+
+/// Finds the triangles of a mesh that an infinite line may cross. It only *selects* candidates
+/// (in single precision, say); the caller refines each one in double precision against the
+/// triangle itself, so an implementation may report false positives near edges but must not
+/// miss a triangle the line crosses (a watertight test reports at least one of the triangles
+/// sharing an edge that the line crosses).
+class MeshRayCaster {
+ public:
+  /// Called once per candidate triangle (index into TriangleMesh::triangles' columns) with the
+  /// `user` pointer given to for_each_line_candidate. Must not throw.
+  using Visitor = void (*)(void* user, int triangle) noexcept;
+
+  MeshRayCaster() = default;
+  MeshRayCaster(const MeshRayCaster&) = delete;
+  MeshRayCaster& operator=(const MeshRayCaster&) = delete;
+  virtual ~MeshRayCaster() = default;
+
+  /// Visits every triangle crossed by the line p(λ) = origin + λ direction, λ ∈ R (both
+  /// directions), in the mesh frame. `direction` is a unit vector. Each triangle is visited at
+  /// least once (possibly more), in no particular order.
+  /// Real-time safe: const, noexcept, allocation-free, callable from several threads at once.
+  virtual void for_each_line_candidate(const Vector3& origin, const Vector3& direction,
+                                       Visitor visit, void* user) const noexcept = 0;
+};
+
+}  // namespace extwrench
