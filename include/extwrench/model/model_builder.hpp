@@ -14,6 +14,8 @@ struct LinkSpec {
   std::string name;
   Inertia inertia;       ///< in the link frame (URDF <inertial> already applied)
   std::string source;    ///< where it was defined, for error messages, e.g. "robot.urdf:12"
+  /// Where the mass properties were given (e.g. the <inertia> element); empty: `source`.
+  std::string inertia_source;
 };
 
 enum class JointSpecType { kRevolute, kContinuous, kPrismatic, kFixed };

@@ -1,0 +1,148 @@
+#include "loader_detail.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <system_error>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/io/mesh.hpp"
+
+namespace extwrench::io_detail {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+bool exists_file(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_regular_file(p, ec);
+}
+
+}  // namespace
+
+std::optional<double> parse_double(std::string_view text) {
+  std::string_view s = trim(text);
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);  // from_chars refuses a leading '+'
+  if (s.empty() || s.front() == '+') return std::nullopt;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+std::vector<std::string_view> split_ws(std::string_view text) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    while (i < text.size() && is_space(text[i])) ++i;
+    const std::size_t start = i;
+    while (i < text.size() && !is_space(text[i])) ++i;
+    if (i > start) out.push_back(text.substr(start, i - start));
+  }
+  return out;
+}
+
+std::optional<fs::path> resolve_mesh_path(const std::string& uri, const fs::path& base_dir,
+                                          const LoadOptions& options, std::string* why) {
+  constexpr std::string_view kPackage = "package://";
+  constexpr std::string_view kFile = "file://";
+  const std::string_view u(uri);
+  if (u.substr(0, kPackage.size()) == kPackage) {
+    const std::string_view rest = u.substr(kPackage.size());
+    const auto slash = rest.find('/');
+    if (slash == std::string_view::npos || slash == 0) {
+      if (why) *why = "expected package://NAME/path, got '" + uri + "'";
+      return std::nullopt;
+    }
+    const std::string package(rest.substr(0, slash));
+    const std::string relative(rest.substr(slash + 1));
+    std::vector<fs::path> dirs = options.package_path;
+    if (options.use_ros_package_path) {
+      if (const char* env = std::getenv("ROS_PACKAGE_PATH")) {
+        for (std::string_view e(env); !e.empty();) {
+          const auto colon = e.find(':');
+          const std::string_view dir = e.substr(0, colon);
+          if (!dir.empty()) dirs.emplace_back(std::string(dir));
+          if (colon == std::string_view::npos) break;
+          e.remove_prefix(colon + 1);
+        }
+      }
+    }
+    for (const fs::path& dir : dirs) {
+      // A search directory contains packages; it may also be the package itself (ROS allows both).
+      for (const fs::path& candidate : {dir / package / relative, dir.filename() == package ? dir / relative : fs::path()}) {
+        if (!candidate.empty() && exists_file(candidate)) return candidate;
+      }
+    }
+    if (why) {
+      *why = "cannot resolve '" + uri + "': no file '" + relative + "' in a package '" + package +
+             "' under LoadOptions::package_path" + (options.use_ros_package_path ? " or ROS_PACKAGE_PATH" : "") + " (" +
+             std::to_string(dirs.size()) + " directories searched)";
+    }
+    return std::nullopt;
+  }
+  fs::path p;
+  if (u.substr(0, kFile.size()) == kFile) {
+    p = fs::path(std::string(u.substr(kFile.size())));
+  } else if (const auto scheme = u.find("://"); scheme != std::string_view::npos) {
+    if (why) *why = "unsupported URI scheme in '" + uri + "' (expected package://, file:// or a path)";
+    return std::nullopt;
+  } else {
+    p = fs::path(uri);
+    if (p.is_relative()) p = base_dir / p;
+  }
+  if (!exists_file(p)) {
+    if (why) *why = "mesh file '" + p.string() + "' not found (from '" + uri + "')";
+    return std::nullopt;
+  }
+  return p;
+}
+
+GeometryModel build_geometry(const Model& model, const std::vector<ShapeSpec>& shapes, const fs::path& base_dir,
+                             const LoadOptions& options) {
+  GeometryModel geometry;
+  geometry.body_shapes.resize(static_cast<std::size_t>(model.num_bodies()));
+  for (const ShapeSpec& spec : shapes) {
+    const auto f = model.find_frame(spec.frame);
+    if (!f) throw Error(spec.source + ": no link or frame named '" + spec.frame + "'");
+    const Frame& frame = model.frames[static_cast<std::size_t>(*f)];
+    CollisionShape shape = spec.shape;
+    shape.link = spec.frame;
+    shape.body = frame.body;
+    // Shapes of links merged by fixed joints move onto the merged body with the link's placement.
+    shape.placement = frame.placement * spec.shape.placement;
+    if (shape.type == ShapeType::kMesh) {
+      std::string why;
+      const auto path = resolve_mesh_path(spec.mesh_uri, base_dir, options, &why);
+      if (options.load_meshes) {
+        if (!path) throw Error(spec.source + ": attribute 'filename': " + why);
+        try {
+          shape.mesh = load_mesh(*path, shape.scale);
+        } catch (const Error& e) {
+          throw Error(spec.source + ": " + e.what());
+        }
+      } else {
+        // Kept without triangles, so tools can still list it.
+        auto mesh = std::make_shared<TriangleMesh>();
+        mesh->path = path ? path->string() : spec.mesh_uri;
+        mesh->vertices.resize(3, 0);
+        mesh->triangles.resize(3, 0);
+        shape.mesh = std::move(mesh);
+      }
+    }
+    geometry.body_shapes[static_cast<std::size_t>(shape.body)].push_back(static_cast<int>(geometry.shapes.size()));
+    geometry.shapes.push_back(std::move(shape));
+  }
+  return geometry;
+}
+
+}  // namespace extwrench::io_detail

@@ -1,0 +1,261 @@
+// URDF -> ModelBuilder specs + collision shapes (tinyxml2). Strict: every number we read must be
+// a whole finite number, every required attribute present; errors name file:line, element,
+// attribute and the offending text. The subset and the <capsule> extension: docs/model.md.
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <tinyxml2.h>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/io/robot_loader.hpp"
+#include "extwrench/model/model_builder.hpp"
+#include "loader_detail.hpp"
+
+namespace extwrench {
+
+namespace {
+
+namespace fs = std::filesystem;
+using tinyxml2::XMLElement;
+
+class UrdfParser {
+ public:
+  explicit UrdfParser(std::string file) : file_(std::move(file)) {}
+
+  RobotDescription parse(const std::string& xml, const fs::path& base_dir, const LoadOptions& options) {
+    tinyxml2::XMLDocument doc;
+    if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
+      throw Error(file_ + ":" + std::to_string(doc.ErrorLineNum()) + ": not well-formed XML: " +
+                  (doc.ErrorStr() ? doc.ErrorStr() : "unknown error"));
+    }
+    const XMLElement* robot = doc.RootElement();
+    if (robot == nullptr || std::strcmp(robot->Name(), "robot") != 0) {
+      throw Error(file_ + ":" + std::to_string(robot ? robot->GetLineNum() : 1) +
+                  ": the root element must be <robot>, got <" + (robot ? robot->Name() : "") + ">");
+    }
+    ModelBuilder builder;
+    if (const char* name = robot->Attribute("name")) builder.set_name(name);
+    if (options.gravity) builder.set_gravity(*options.gravity);
+    // Only direct children: <link> inside <gazebo> & co. are not links. Unknown elements
+    // (<gazebo>, <transmission>, <material>, <mujoco>, ...) are extensions and ignored.
+    for (const XMLElement* e = robot->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+      if (std::strcmp(e->Name(), "link") == 0) {
+        builder.add_link(parse_link(e));
+      } else if (std::strcmp(e->Name(), "joint") == 0) {
+        builder.add_joint(parse_joint(e));
+      }
+    }
+    RobotDescription robot_description;
+    robot_description.model = builder.build();
+    robot_description.geometry = io_detail::build_geometry(robot_description.model, shapes_, base_dir, options);
+    return robot_description;
+  }
+
+ private:
+  std::string where(const XMLElement* e) const { return file_ + ":" + std::to_string(e->GetLineNum()); }
+  // "file:line: <inertia> of link 'x'"
+  std::string context(const XMLElement* e, const std::string& owner) const {
+    return where(e) + ": <" + e->Name() + ">" + (owner.empty() ? "" : " of " + owner);
+  }
+
+  [[noreturn]] void fail(const XMLElement* e, const std::string& owner, const std::string& what) const {
+    throw Error(context(e, owner) + ": " + what);
+  }
+
+  const char* required(const XMLElement* e, const char* attr, const std::string& owner) const {
+    const char* v = e->Attribute(attr);
+    if (v == nullptr) fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
+    return v;
+  }
+
+  const XMLElement* required_child(const XMLElement* e, const char* name, const std::string& owner) const {
+    const XMLElement* c = e->FirstChildElement(name);
+    if (c == nullptr) fail(e, owner, std::string("missing element <") + name + ">");
+    return c;
+  }
+
+  double number(const XMLElement* e, const char* attr, const std::string& owner, std::optional<double> fallback) const {
+    const char* v = e->Attribute(attr);
+    if (v == nullptr) {
+      if (fallback) return *fallback;
+      fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
+    }
+    const auto d = io_detail::parse_double(v);
+    if (!d) fail(e, owner, std::string("attribute '") + attr + "': expected a number, got '" + v + "'");
+    return *d;
+  }
+
+  Vector3 vector3(const XMLElement* e, const char* attr, const std::string& owner, std::optional<Vector3> fallback) const {
+    const char* v = e->Attribute(attr);
+    if (v == nullptr) {
+      if (fallback) return *fallback;
+      fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
+    }
+    const auto tokens = io_detail::split_ws(v);
+    Vector3 out;
+    bool ok = tokens.size() == 3;
+    for (std::size_t i = 0; ok && i < 3; ++i) {
+      const auto d = io_detail::parse_double(tokens[i]);
+      ok = d.has_value();
+      if (ok) out[static_cast<Eigen::Index>(i)] = *d;
+    }
+    if (!ok) fail(e, owner, std::string("attribute '") + attr + "': expected 3 numbers, got '" + v + "'");
+    return out;
+  }
+
+  // Optional <origin xyz rpy> child; identity when absent. The first one counts (as urdfdom).
+  Pose origin(const XMLElement* parent, const std::string& owner) const {
+    const XMLElement* o = parent->FirstChildElement("origin");
+    if (o == nullptr) return Pose::identity();
+    return Pose::from_xyz_rpy(vector3(o, "xyz", owner, Vector3::Zero()), vector3(o, "rpy", owner, Vector3::Zero()));
+  }
+
+  LinkSpec parse_link(const XMLElement* e) {
+    LinkSpec link;
+    link.source = where(e);
+    link.name = required(e, "name", "");
+    const std::string owner = "link '" + link.name + "'";
+    if (const XMLElement* inertial = e->FirstChildElement("inertial")) {
+      // URDF gives the inertia about the CoM in the <inertial><origin> frame: move it to the link frame.
+      const Pose X_link_inertial = origin(inertial, owner);
+      const XMLElement* mass = required_child(inertial, "mass", owner);
+      const XMLElement* inertia = required_child(inertial, "inertia", owner);
+      Inertia in;
+      in.mass = number(mass, "value", owner, std::nullopt);
+      const double ixx = number(inertia, "ixx", owner, std::nullopt);
+      const double ixy = number(inertia, "ixy", owner, std::nullopt);
+      const double ixz = number(inertia, "ixz", owner, std::nullopt);
+      const double iyy = number(inertia, "iyy", owner, std::nullopt);
+      const double iyz = number(inertia, "iyz", owner, std::nullopt);
+      const double izz = number(inertia, "izz", owner, std::nullopt);
+      in.inertia_com << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
+      link.inertia = in.transformed(X_link_inertial);
+      link.inertia_source = where(inertia) + ": <inertial>";
+    }
+    for (const XMLElement* c = e->FirstChildElement("collision"); c != nullptr; c = c->NextSiblingElement("collision")) {
+      parse_collision(c, link.name, owner);
+    }
+    return link;
+  }
+
+  void parse_collision(const XMLElement* c, const std::string& link, const std::string& owner) {
+    const XMLElement* geometry = required_child(c, "geometry", owner);
+    const XMLElement* g = geometry->FirstChildElement();
+    if (g == nullptr) fail(geometry, owner, "missing shape (sphere, box, cylinder, capsule or mesh)");
+    io_detail::ShapeSpec spec;
+    spec.frame = link;
+    spec.source = context(g, owner);
+    CollisionShape& s = spec.shape;
+    s.placement = origin(c, owner);
+    const std::string type = g->Name();
+    auto positive = [&](const char* attr) {
+      const double v = number(g, attr, owner, std::nullopt);
+      if (!(v > 0.0)) fail(g, owner, std::string("attribute '") + attr + "': must be positive, got '" + g->Attribute(attr) + "'");
+      return v;
+    };
+    if (type == "sphere") {
+      s.type = ShapeType::kSphere;
+      s.radius = positive("radius");
+    } else if (type == "box") {
+      s.type = ShapeType::kBox;
+      s.size = vector3(g, "size", owner, std::nullopt);
+      if (!(s.size.minCoeff() > 0.0)) fail(g, owner, std::string("attribute 'size': must be positive, got '") + g->Attribute("size") + "'");
+    } else if (type == "cylinder" || type == "capsule") {
+      // <capsule radius length/> is our extension (URDF has none): length excludes the caps.
+      s.type = type == "cylinder" ? ShapeType::kCylinder : ShapeType::kCapsule;
+      s.radius = positive("radius");
+      s.length = number(g, "length", owner, std::nullopt);
+      if (s.length < 0.0 || (s.type == ShapeType::kCylinder && s.length == 0.0)) {
+        fail(g, owner, std::string("attribute 'length': must be positive, got '") + g->Attribute("length") + "'");
+      }
+    } else if (type == "mesh") {
+      s.type = ShapeType::kMesh;
+      spec.mesh_uri = required(g, "filename", owner);
+      if (spec.mesh_uri.empty()) fail(g, owner, "attribute 'filename': must not be empty");
+      s.scale = vector3(g, "scale", owner, Vector3::Ones());
+      if (s.scale.cwiseAbs().minCoeff() == 0.0) fail(g, owner, std::string("attribute 'scale': must not be zero, got '") + g->Attribute("scale") + "'");
+    } else {
+      fail(g, owner, "unknown geometry <" + type + "> (expected sphere, box, cylinder, capsule or mesh)");
+    }
+    shapes_.push_back(std::move(spec));
+  }
+
+  JointSpec parse_joint(const XMLElement* e) {
+    JointSpec j;
+    j.source = where(e);
+    j.name = required(e, "name", "");
+    const std::string owner = "joint '" + j.name + "'";
+    const std::string type = required(e, "type", owner);
+    if (type == "revolute") {
+      j.type = JointSpecType::kRevolute;
+    } else if (type == "continuous") {
+      j.type = JointSpecType::kContinuous;
+    } else if (type == "prismatic") {
+      j.type = JointSpecType::kPrismatic;
+    } else if (type == "fixed") {
+      j.type = JointSpecType::kFixed;
+    } else if (type == "floating" || type == "planar") {
+      fail(e, owner, "attribute 'type': unsupported joint type '" + type + "' (only 1-DoF and fixed joints)");
+    } else {
+      fail(e, owner, "attribute 'type': unknown joint type '" + type + "' (expected revolute, continuous, prismatic or fixed)");
+    }
+    j.parent = required(required_child(e, "parent", owner), "link", owner);
+    j.child = required(required_child(e, "child", owner), "link", owner);
+    j.origin = origin(e, owner);
+    if (const XMLElement* axis = e->FirstChildElement("axis")) {
+      j.axis = vector3(axis, "xyz", owner, Vector3::UnitX());
+      if (j.type != JointSpecType::kFixed && j.axis.norm() < 1e-12) {
+        fail(axis, owner, std::string("attribute 'xyz': the axis must not be zero, got '") + axis->Attribute("xyz") + "'");
+      }
+    }
+    const XMLElement* limit = e->FirstChildElement("limit");
+    if (limit == nullptr && (j.type == JointSpecType::kRevolute || j.type == JointSpecType::kPrismatic)) {
+      fail(e, owner, "missing element <limit> (required for " + type + " joints)");
+    }
+    if (limit != nullptr && j.type != JointSpecType::kFixed) {
+      j.effort_limit = number(limit, "effort", owner, std::nullopt);
+      j.velocity_limit = number(limit, "velocity", owner, std::nullopt);
+      if (j.type != JointSpecType::kContinuous) {
+        j.lower = number(limit, "lower", owner, 0.0);
+        j.upper = number(limit, "upper", owner, 0.0);
+        if (j.lower > j.upper) {
+          fail(limit, owner, std::string("attributes 'lower' > 'upper' ('") + limit->Attribute("lower") + "' > '" +
+                                 limit->Attribute("upper") + "')");
+        }
+      }
+      if (j.effort_limit < 0.0) fail(limit, owner, std::string("attribute 'effort': must not be negative, got '") + limit->Attribute("effort") + "'");
+      if (j.velocity_limit < 0.0) fail(limit, owner, std::string("attribute 'velocity': must not be negative, got '") + limit->Attribute("velocity") + "'");
+    }
+    if (const XMLElement* dyn = e->FirstChildElement("dynamics")) {
+      j.damping = number(dyn, "damping", owner, 0.0);
+      j.friction = number(dyn, "friction", owner, 0.0);
+    }
+    return j;
+  }
+
+  std::string file_;
+  std::vector<io_detail::ShapeSpec> shapes_;
+};
+
+}  // namespace
+
+RobotDescription load_urdf_string(const std::string& xml, const std::string& name, const LoadOptions& options) {
+  UrdfParser parser(name);
+  RobotDescription r = parser.parse(xml, fs::current_path(), options);
+  r.source = name;
+  return r;
+}
+
+RobotDescription load_urdf(const fs::path& path, const LoadOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path.string() + ": cannot open file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  UrdfParser parser(path.string());
+  RobotDescription r = parser.parse(text.str(), path.parent_path().empty() ? fs::path(".") : path.parent_path(), options);
+  r.source = path;
+  return r;
+}
+
+}  // namespace extwrench

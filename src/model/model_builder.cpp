@@ -1,0 +1,373 @@
+// ModelBuilder: URDF-like links and joints -> a validated Model (fixed joints merged,
+// bodies in depth-first order), plus the physical-consistency checks of mass properties.
+#include "extwrench/model/model_builder.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include <Eigen/Eigenvalues>
+
+#include "extwrench/core/error.hpp"
+
+namespace extwrench {
+
+namespace {
+
+// Relative tolerance of the symmetry, positive semi-definiteness and triangle-inequality tests:
+// a thin rod (I_zz = 0, I_xx = I_yy) sits exactly on the boundary and must pass after the
+// rounding of a text file (about 1e-9 relative with 9-10 printed digits).
+constexpr double kInertiaRelTol = 1e-8;
+// Smallest eigenvalue of M(0) relative to its largest below which M(0) counts as singular.
+constexpr double kMassMatrixRelTol = 1e-12;
+// |axis| below this is a zero axis.
+constexpr double kMinAxisNorm = 1e-12;
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+std::string prefix(const std::string& source) { return source.empty() ? std::string() : source + ": "; }
+
+bool finite(const Pose& x) { return x.rotation.allFinite() && x.translation.allFinite(); }
+
+bool is_rotation(const Matrix3& r) {
+  return (r.transpose() * r - Matrix3::Identity()).cwiseAbs().maxCoeff() < 1e-9 && r.determinant() > 0.0;
+}
+
+const char* type_name(JointSpecType t) {
+  switch (t) {
+    case JointSpecType::kRevolute: return "revolute";
+    case JointSpecType::kContinuous: return "continuous";
+    case JointSpecType::kPrismatic: return "prismatic";
+    case JointSpecType::kFixed: return "fixed";
+  }
+  return "unknown";
+}
+
+// Joint-space mass matrix at q = 0, from per-body 6D Jacobians: M = sum_b J_b^T I_b J_b, with
+// world-frame spatial inertias about the world origin ([linear; angular] order). Kept here
+// (and not borrowed from dynamics/) so that validation does not depend on the algorithms it
+// guards.
+MatrixX mass_matrix_at_zero(const Model& model) {
+  const int nb = model.num_bodies();
+  const int n = model.nq();
+  std::vector<Pose> X_WB(static_cast<std::size_t>(nb));
+  std::vector<Vector6> S(static_cast<std::size_t>(nb), Vector6::Zero());
+  for (int i = 1; i < nb; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    const Joint& j = model.joints[ui];
+    X_WB[ui] = X_WB[static_cast<std::size_t>(model.parents[ui])] * j.placement;
+    const Vector3 axis_W = X_WB[ui].rotation * j.axis;
+    if (j.type == JointType::kRevolute) {
+      // Velocity of the body point at the world origin: w x (0 - p) = p x w.
+      S[ui] << X_WB[ui].translation.cross(axis_W), axis_W;
+    } else {
+      S[ui] << axis_W, Vector3::Zero();
+    }
+  }
+  MatrixX M = MatrixX::Zero(n, n);
+  Matrix6X J(6, n);
+  for (int b = 1; b < nb; ++b) {
+    const auto ub = static_cast<std::size_t>(b);
+    const Inertia& in = model.bodies[ub].inertia;
+    const double m = in.mass;
+    const Vector3 c = X_WB[ub].act(in.com);
+    const Matrix3 Sc = skew(c);
+    Matrix6 I6;
+    I6.topLeftCorner<3, 3>() = m * Matrix3::Identity();
+    I6.topRightCorner<3, 3>() = -m * Sc;
+    I6.bottomLeftCorner<3, 3>() = m * Sc;
+    I6.bottomRightCorner<3, 3>() =
+        X_WB[ub].rotation * in.inertia_com * X_WB[ub].rotation.transpose() - m * Sc * Sc;
+    J.setZero();
+    for (int k = b; k > 0; k = model.parents[static_cast<std::size_t>(k)]) {
+      J.col(k - 1) = S[static_cast<std::size_t>(k)];
+    }
+    M.noalias() += J.transpose() * I6 * J;
+  }
+  return M;
+}
+
+// Body whose joint makes M(0) singular (the largest entry of the null eigenvector), or -1.
+int singular_mass_matrix_body(const Model& model) {
+  if (model.nq() == 0) return -1;
+  const MatrixX M = mass_matrix_at_zero(model);
+  if (!M.allFinite()) return 1;
+  Eigen::SelfAdjointEigenSolver<MatrixX> eig(M);
+  const VectorX& lambda = eig.eigenvalues();
+  const double scale = std::max(lambda.cwiseAbs().maxCoeff(), 1e-300);
+  if (lambda(0) > kMassMatrixRelTol * scale) return -1;
+  Eigen::Index k = 0;
+  eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
+  return static_cast<int>(k) + 1;
+}
+
+}  // namespace
+
+void validate_inertia(const Inertia& inertia, const std::string& where) {
+  const std::string p = where.empty() ? std::string() : where + ": ";
+  if (!std::isfinite(inertia.mass)) throw Error(p + "mass: expected a finite number, got " + num(inertia.mass));
+  if (inertia.mass < 0.0) throw Error(p + "mass: must not be negative, got " + num(inertia.mass));
+  if (!inertia.com.allFinite()) throw Error(p + "centre of mass: expected finite numbers");
+  const Matrix3& I = inertia.inertia_com;
+  if (!I.allFinite()) throw Error(p + "inertia: expected finite numbers");
+  const double scale = I.cwiseAbs().maxCoeff();
+  const char* names[3] = {"x", "y", "z"};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = r + 1; c < 3; ++c) {
+      if (std::abs(I(r, c) - I(c, r)) > kInertiaRelTol * scale) {
+        throw Error(p + "inertia: not symmetric (i" + names[r] + names[c] + " = " + num(I(r, c)) + ", i" +
+                    names[c] + names[r] + " = " + num(I(c, r)) + ")");
+      }
+    }
+  }
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(0.5 * (I + I.transpose()), Eigen::EigenvaluesOnly);
+  const Vector3 l = eig.eigenvalues();  // ascending
+  const std::string moments = "principal moments " + num(l(0)) + ", " + num(l(1)) + ", " + num(l(2));
+  if (l(0) < -kInertiaRelTol * scale) {
+    throw Error(p + "inertia: not positive semi-definite (" + moments + ")");
+  }
+  // A rigid body's principal moments satisfy I_a + I_b >= I_c (equality: planar body).
+  if (l(0) + l(1) < l(2) - kInertiaRelTol * scale) {
+    throw Error(p + "inertia: principal moments violate the triangle inequality (" + moments + ": " +
+                num(l(0)) + " + " + num(l(1)) + " < " + num(l(2)) + ")");
+  }
+}
+
+void validate_model(const Model& model) {
+  const std::string p = "model '" + model.name + "': ";
+  const auto nb = model.bodies.size();
+  if (nb == 0) throw Error(p + "no bodies");
+  if (model.joints.size() != nb || model.parents.size() != nb) {
+    throw Error(p + "bodies, joints and parents differ in size (" + std::to_string(nb) + ", " +
+                std::to_string(model.joints.size()) + ", " + std::to_string(model.parents.size()) + ")");
+  }
+  if (model.parents[0] != -1) throw Error(p + "parents[0] must be -1");
+  if (!model.gravity.allFinite()) throw Error(p + "gravity: expected finite numbers");
+  for (std::size_t i = 0; i < nb; ++i) {
+    const std::string body = "body " + std::to_string(i) + " '" + model.bodies[i].name + "'";
+    validate_inertia(model.bodies[i].inertia, p + body);
+    if (i == 0) continue;
+    if (model.parents[i] < 0 || model.parents[i] >= static_cast<int>(i)) {
+      throw Error(p + body + ": parent " + std::to_string(model.parents[i]) + " is not a lower index");
+    }
+    const Joint& j = model.joints[i];
+    const std::string jn = p + "joint '" + j.name + "'";
+    if (!finite(j.placement) || !is_rotation(j.placement.rotation)) {
+      throw Error(jn + ": placement: expected a finite rigid transform");
+    }
+    if (!j.axis.allFinite() || std::abs(j.axis.norm() - 1.0) > 1e-9) {
+      throw Error(jn + ": axis: expected a unit vector, got (" + num(j.axis.x()) + " " + num(j.axis.y()) + " " +
+                  num(j.axis.z()) + ")");
+    }
+    if (std::isnan(j.lower) || std::isnan(j.upper) || j.lower > j.upper) {
+      throw Error(jn + ": limits: lower " + num(j.lower) + " > upper " + num(j.upper));
+    }
+    if (!(j.velocity_limit >= 0.0) || !(j.effort_limit >= 0.0)) {
+      throw Error(jn + ": velocity and effort limits must be non-negative");
+    }
+    if (!std::isfinite(j.damping) || !std::isfinite(j.friction)) {
+      throw Error(jn + ": damping and friction must be finite");
+    }
+  }
+  for (const Frame& f : model.frames) {
+    if (f.body < 0 || f.body >= static_cast<int>(nb)) throw Error(p + "frame '" + f.name + "': body out of range");
+    if (!finite(f.placement)) throw Error(p + "frame '" + f.name + "': placement: expected finite numbers");
+  }
+  const int bad = singular_mass_matrix_body(model);
+  if (bad > 0) {
+    const auto ub = static_cast<std::size_t>(bad);
+    throw Error(p + "joint '" + model.joints[ub].name + "' (body '" + model.bodies[ub].name +
+                "'): the joint-space mass matrix is not positive definite at q = 0 (the bodies this "
+                "joint moves carry no mass or inertia about its axis)");
+  }
+}
+
+Model ModelBuilder::build() const {
+  const std::string model_where = "robot '" + name_ + "'";
+  if (links_.empty()) throw Error(model_where + ": no links");
+  if (!gravity_.allFinite()) throw Error(model_where + ": gravity: expected finite numbers");
+
+  // --- links: unique names, physical mass properties (in file order: the first bad link wins)
+  std::map<std::string, int, std::less<>> link_index;
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    const LinkSpec& l = links_[i];
+    const std::string where = prefix(l.source) + "link '" + l.name + "'";
+    if (l.name.empty()) throw Error(prefix(l.source) + "link: attribute 'name': must not be empty");
+    const auto [it, inserted] = link_index.emplace(l.name, static_cast<int>(i));
+    if (!inserted) {
+      throw Error(where + ": duplicate link name (first defined at " +
+                  links_[static_cast<std::size_t>(it->second)].source + ")");
+    }
+    validate_inertia(l.inertia, prefix(l.inertia_source.empty() ? l.source : l.inertia_source) + "link '" +
+                                    l.name + "'");
+  }
+
+  // --- joints: names, endpoints, numbers, one parent per link
+  std::set<std::string, std::less<>> joint_names;
+  std::vector<int> parent_joint(links_.size(), -1);
+  std::vector<std::vector<int>> child_joints(links_.size());
+  for (std::size_t k = 0; k < joints_.size(); ++k) {
+    const JointSpec& j = joints_[k];
+    const std::string where = prefix(j.source) + "joint '" + j.name + "'";
+    if (j.name.empty()) throw Error(prefix(j.source) + "joint: attribute 'name': must not be empty");
+    if (!joint_names.insert(j.name).second) throw Error(where + ": duplicate joint name");
+    const auto parent = link_index.find(j.parent);
+    if (parent == link_index.end()) throw Error(where + ": parent: no link named '" + j.parent + "'");
+    const auto child = link_index.find(j.child);
+    if (child == link_index.end()) throw Error(where + ": child: no link named '" + j.child + "'");
+    if (parent->second == child->second) {
+      throw Error(where + ": parent and child are the same link '" + j.child + "' (a cycle)");
+    }
+    int& pj = parent_joint[static_cast<std::size_t>(child->second)];
+    if (pj >= 0) {
+      throw Error(where + ": child: link '" + j.child + "' already has a parent joint '" +
+                  joints_[static_cast<std::size_t>(pj)].name + "' (" + joints_[static_cast<std::size_t>(pj)].source +
+                  "); a link can have only one parent");
+    }
+    pj = static_cast<int>(k);
+    child_joints[static_cast<std::size_t>(parent->second)].push_back(static_cast<int>(k));
+
+    if (!finite(j.origin) || !is_rotation(j.origin.rotation)) {
+      throw Error(where + ": origin: expected finite numbers");
+    }
+    if (j.type == JointSpecType::kFixed) continue;
+    if (!j.axis.allFinite()) throw Error(where + ": axis: expected finite numbers");
+    if (j.axis.norm() < kMinAxisNorm) throw Error(where + ": axis: must not be zero");
+    if (std::isnan(j.lower) || std::isnan(j.upper)) throw Error(where + ": limit: lower/upper must be numbers");
+    if (j.type != JointSpecType::kContinuous && j.lower > j.upper) {
+      throw Error(where + ": limit: lower " + num(j.lower) + " > upper " + num(j.upper));
+    }
+    if (!(j.velocity_limit >= 0.0)) throw Error(where + ": limit: velocity must be non-negative, got " + num(j.velocity_limit));
+    if (!(j.effort_limit >= 0.0)) throw Error(where + ": limit: effort must be non-negative, got " + num(j.effort_limit));
+    if (!std::isfinite(j.damping)) throw Error(where + ": dynamics: damping must be finite");
+    if (!std::isfinite(j.friction)) throw Error(where + ": dynamics: friction must be finite");
+  }
+
+  // --- exactly one root, no cycles
+  std::vector<int> roots;
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    if (parent_joint[i] < 0) roots.push_back(static_cast<int>(i));
+  }
+  auto describe_cycle = [&](int start) {
+    // Every link on the way has a parent (else it would be reachable from a root): walk up.
+    std::vector<int> path;
+    std::vector<int> seen_at(links_.size(), -1);
+    int l = start;
+    while (seen_at[static_cast<std::size_t>(l)] < 0) {
+      seen_at[static_cast<std::size_t>(l)] = static_cast<int>(path.size());
+      path.push_back(l);
+      l = link_index.find(joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])].parent)->second;
+    }
+    std::string chain;
+    const int first = seen_at[static_cast<std::size_t>(l)];
+    for (std::size_t i = path.size(); i-- > static_cast<std::size_t>(first);) {
+      chain += "'" + links_[static_cast<std::size_t>(path[i])].name + "' -> ";
+    }
+    chain += "'" + links_[static_cast<std::size_t>(l)].name + "'";
+    const JointSpec& j = joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])];
+    return Error(prefix(j.source) + "joint '" + j.name + "': closes a cycle of links: " + chain);
+  };
+  if (roots.empty()) throw describe_cycle(0);
+  if (roots.size() > 1) {
+    const LinkSpec& a = links_[static_cast<std::size_t>(roots[0])];
+    const LinkSpec& b = links_[static_cast<std::size_t>(roots[1])];
+    throw Error(prefix(b.source) + "link '" + b.name + "': more than one root link ('" + a.name + "' at " +
+                a.source + " and '" + b.name + "' have no parent joint); the links must form one tree");
+  }
+
+  // --- depth-first traversal: a moving joint starts a new body, a fixed one merges its child
+  Model model;
+  model.name = name_;
+  model.gravity = gravity_;
+  struct Item {
+    int link;
+    int joint;         // joint whose child is `link`, -1 for the root
+    int parent_body;   // body of the joint's parent link
+    Pose X_body_parent_link;  // pose of the parent link in that body
+  };
+  std::vector<Item> stack{{roots[0], -1, -1, Pose::identity()}};
+  std::vector<bool> visited(links_.size(), false);
+  std::vector<std::string> body_source;  // for the mass-matrix error
+  while (!stack.empty()) {
+    const Item it = stack.back();
+    stack.pop_back();
+    const LinkSpec& l = links_[static_cast<std::size_t>(it.link)];
+    visited[static_cast<std::size_t>(it.link)] = true;
+    int body = 0;
+    Pose X_body_link;
+    const JointSpec* js = it.joint >= 0 ? &joints_[static_cast<std::size_t>(it.joint)] : nullptr;
+    if (js == nullptr || js->type != JointSpecType::kFixed) {
+      body = model.num_bodies();
+      Body b;
+      b.name = l.name;
+      model.bodies.push_back(b);
+      model.parents.push_back(it.parent_body);
+      Joint j;
+      if (js != nullptr) {
+        j.name = js->name;
+        j.type = js->type == JointSpecType::kPrismatic ? JointType::kPrismatic : JointType::kRevolute;
+        j.placement = it.X_body_parent_link * js->origin;
+        j.axis = js->axis.normalized();
+        if (js->type != JointSpecType::kContinuous) {
+          j.lower = js->lower;
+          j.upper = js->upper;
+        }
+        j.velocity_limit = js->velocity_limit;
+        j.effort_limit = js->effort_limit;
+        j.damping = js->damping;
+        j.friction = js->friction;
+        body_source.push_back(prefix(js->source) + "joint '" + js->name + "' (" + type_name(js->type) +
+                              ") moving link '" + l.name + "'");
+      } else {
+        body_source.push_back(prefix(l.source) + "link '" + l.name + "'");
+      }
+      model.joints.push_back(j);
+    } else {
+      body = it.parent_body;
+      X_body_link = it.X_body_parent_link * js->origin;
+    }
+    model.frames.push_back(Frame{l.name, body, X_body_link});
+    Body& b = model.bodies[static_cast<std::size_t>(body)];
+    b.inertia = b.inertia + l.inertia.transformed(X_body_link);
+    const auto& children = child_joints[static_cast<std::size_t>(it.link)];
+    for (auto c = children.rbegin(); c != children.rend(); ++c) {
+      const int child = link_index.find(joints_[static_cast<std::size_t>(*c)].child)->second;
+      stack.push_back(Item{child, *c, body, X_body_link});
+    }
+  }
+  for (std::size_t i = 0; i < links_.size(); ++i) {
+    if (!visited[i]) throw describe_cycle(static_cast<int>(i));
+  }
+
+  // --- extra frames
+  for (const FrameSpec& f : frames_) {
+    const std::string where = prefix(f.source) + "frame '" + f.name + "'";
+    if (f.name.empty()) throw Error(prefix(f.source) + "frame: name must not be empty");
+    if (model.find_frame(f.name)) throw Error(where + ": duplicate frame name (a link or frame has it already)");
+    const auto lf = model.find_frame(f.link);
+    if (!lf) throw Error(where + ": link: no link or frame named '" + f.link + "'");
+    if (!finite(f.placement) || !is_rotation(f.placement.rotation)) {
+      throw Error(where + ": placement: expected finite numbers");
+    }
+    const Frame& parent = model.frames[static_cast<std::size_t>(*lf)];
+    model.frames.push_back(Frame{f.name, parent.body, parent.placement * f.placement});
+  }
+
+  // --- a massless body is fine only if M(q = 0) stays positive definite
+  const int bad = singular_mass_matrix_body(model);
+  if (bad > 0) {
+    throw Error(body_source[static_cast<std::size_t>(bad)] +
+                ": the joint-space mass matrix is not positive definite at q = 0: the links this joint "
+                "moves carry no mass or inertia about its axis (give the child link an <inertial>, or "
+                "make the joint fixed)");
+  }
+  validate_model(model);
+  return model;
+}
+
+}  // namespace extwrench
