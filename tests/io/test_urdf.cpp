@@ -1,0 +1,343 @@
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <numbers>
+
+#include <kdl/frames.hpp>
+#include <kdl/jntarray.hpp>
+#include <kdl/tree.hpp>
+#include <kdl/treefksolverpos_recursive.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/io/robot_loader.hpp"
+#include "io_test_util.hpp"
+#include "support/random.hpp"
+
+namespace extwrench {
+namespace {
+
+namespace fs = std::filesystem;
+
+LoadOptions no_meshes() {
+  LoadOptions o;
+  o.load_meshes = false;
+  o.use_ros_package_path = false;
+  return o;
+}
+
+std::string load_error(const fs::path& path, const LoadOptions& o) {
+  try {
+    (void)load_robot(path, o);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+fs::path panda_dir() { return test::shared_models() / "franka_panda/urdf_example-robot-data"; }
+fs::path lwr_dir() { return test::shared_models() / "kuka_lwr4plus/urdf_flobaroid"; }
+
+#define REQUIRE_SHARED() \
+  if (!test::have_shared()) GTEST_SKIP() << "no shared models at " << test::shared_models()
+
+// ---- inline URDFs --------------------------------------------------------------------------
+
+TEST(Urdf, InertialOriginIsConvertedToTheLinkFrame) {
+  const std::string xml = R"(<robot name="r">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="arm">
+    <inertial>
+      <origin xyz="0.1 0.2 0.3" rpy="0 0 1.5707963267948966"/>
+      <mass value="2"/>
+      <inertia ixx="0.3" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.1"/>
+    </inertial>
+  </link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 3"/></joint>
+</robot>)";
+  const Model m = load_urdf_string(xml, "inline.urdf", no_meshes()).model;
+  const Inertia& in = m.bodies[1].inertia;
+  EXPECT_DOUBLE_EQ(in.mass, 2.0);
+  EXPECT_TRUE(in.com.isApprox(Vector3(0.1, 0.2, 0.3)));
+  // Yaw by 90 deg swaps the x and y principal axes: I_link = diag(0.2, 0.3, 0.1).
+  EXPECT_LT((in.inertia_com - Vector3(0.2, 0.3, 0.1).asDiagonal().toDenseMatrix()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_TRUE(m.joints[1].axis.isApprox(Vector3::UnitZ()));
+  EXPECT_TRUE(std::isinf(m.joints[1].lower));
+}
+
+TEST(Urdf, JointLimitsDynamicsAndDefaultsAreKept) {
+  const std::string xml = R"(<robot name="r">
+  <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <joint name="j" type="revolute"><parent link="a"/><child link="b"/>
+    <limit lower="-1" upper="2" velocity="3" effort="4"/><dynamics damping="0.5" friction="0.25"/>
+    <mimic joint="x"/><safety_controller k_velocity="1"/></joint>
+  <gazebo><link name="not_a_link"/></gazebo>
+  <transmission name="t"><joint name="j"/></transmission>
+</robot>)";
+  const Model m = load_urdf_string(xml, "inline.urdf", no_meshes()).model;
+  ASSERT_EQ(m.nq(), 1);
+  const Joint& j = m.joints[1];
+  EXPECT_TRUE(j.axis.isApprox(Vector3::UnitX())) << "URDF default axis";
+  EXPECT_EQ(j.lower, -1.0);
+  EXPECT_EQ(j.upper, 2.0);
+  EXPECT_EQ(j.velocity_limit, 3.0);
+  EXPECT_EQ(j.effort_limit, 4.0);
+  EXPECT_EQ(j.damping, 0.5);
+  EXPECT_EQ(j.friction, 0.25);
+  EXPECT_FALSE(m.find_frame("not_a_link")) << "links inside extension elements are not links";
+}
+
+TEST(Urdf, CollisionShapesOfMergedLinksArePlacedOnTheirBody) {
+  const std::string xml = R"(<robot name="r">
+  <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="b"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <collision><origin xyz="0 0 0.1"/><geometry><sphere radius="0.05"/></geometry></collision></link>
+  <link name="tool">
+    <collision><origin xyz="0.2 0 0" rpy="0 1.5707963267948966 0"/><geometry><capsule radius="0.02" length="0.1"/></geometry></collision>
+    <collision><geometry><box size="0.1 0.2 0.3"/></geometry></collision>
+    <collision><geometry><cylinder radius="0.1" length="0.2"/></geometry></collision>
+    <collision><geometry><mesh filename="package://nowhere/m.stl" scale="2 2 2"/></geometry></collision>
+  </link>
+  <joint name="j" type="prismatic"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/><limit effort="1" velocity="1"/></joint>
+  <joint name="f" type="fixed"><parent link="b"/><child link="tool"/><origin xyz="0 0 0.5" rpy="0 0 1.5707963267948966"/></joint>
+</robot>)";
+  const RobotDescription r = load_urdf_string(xml, "inline.urdf", no_meshes());
+  ASSERT_EQ(r.geometry.shapes.size(), 5u);
+  ASSERT_EQ(r.geometry.body_shapes[1].size(), 5u);
+  const CollisionShape& cap = r.geometry.shapes[1];
+  EXPECT_EQ(cap.type, ShapeType::kCapsule);
+  EXPECT_EQ(cap.link, "tool");
+  EXPECT_EQ(cap.body, 1);
+  // X_{b, shape} = X_{b, tool} X_{tool, shape}: the capsule centre is at (0, 0.2, 0.5) in b.
+  EXPECT_LT((cap.placement.translation - Vector3(0, 0.2, 0.5)).norm(), 1e-12);
+  EXPECT_EQ(r.geometry.shapes[2].size, Vector3(0.1, 0.2, 0.3));
+  EXPECT_EQ(r.geometry.shapes[3].type, ShapeType::kCylinder);
+  const CollisionShape& mesh = r.geometry.shapes[4];
+  EXPECT_EQ(mesh.type, ShapeType::kMesh);
+  EXPECT_EQ(mesh.scale, Vector3(2, 2, 2));
+  ASSERT_TRUE(mesh.mesh);
+  EXPECT_EQ(mesh.mesh->vertices.cols(), 0) << "load_meshes = false keeps the shape without triangles";
+  // With load_meshes the unresolvable package is an error naming the line and the attribute.
+  LoadOptions o = no_meshes();
+  o.load_meshes = true;
+  try {
+    (void)load_urdf_string(xml, "inline.urdf", o);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("inline.urdf:9: <mesh> of link 'tool': attribute 'filename'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("package 'nowhere'"), std::string::npos) << msg;
+  }
+}
+
+TEST(Urdf, GravityCanBeOverridden) {
+  const fs::path file = test::project_models() / "paper_arm.urdf";
+  EXPECT_TRUE(load_robot(file, no_meshes()).model.gravity.isApprox(Vector3(0, 0, -9.81)));
+  LoadOptions o = no_meshes();
+  o.gravity = Vector3(0, 9.81, 0);  // a wall-mounted robot
+  EXPECT_TRUE(load_robot(file, o).model.gravity.isApprox(Vector3(0, 9.81, 0)));
+  EXPECT_TRUE(load_robot(test::project_models() / "paper_arm.yaml", o).model.gravity.isApprox(Vector3(0, 9.81, 0)));
+}
+
+// ---- the shared validation models ------------------------------------------------------------
+
+TEST(UrdfShared, PandaLoadsAsATreeWithItsFingers) {
+  REQUIRE_SHARED();
+  const Model m = load_robot(panda_dir() / "urdf/panda.urdf", no_meshes()).model;
+  EXPECT_EQ(m.nq(), 9);
+  EXPECT_FALSE(m.is_serial_chain());
+  EXPECT_EQ(m.bodies[0].name, "panda_link0");
+  const int hand = m.body_index("panda_hand");
+  EXPECT_EQ(hand, m.body_index("panda_link7")) << "hand and link8 merged into link 7 by fixed joints";
+  const int left = m.body_index("panda_leftfinger");
+  const int right = m.body_index("panda_rightfinger");
+  EXPECT_EQ(m.parents[static_cast<std::size_t>(left)], hand);
+  EXPECT_EQ(m.parents[static_cast<std::size_t>(right)], hand);
+  EXPECT_EQ(m.joints[static_cast<std::size_t>(left)].type, JointType::kPrismatic);
+  EXPECT_TRUE(m.find_frame("panda_hand_tcp"));
+  // urdfdom's total (models/README.md): 17.4519 kg.
+  EXPECT_NEAR(m.total_mass(), 17.4519, 5e-5);
+}
+
+TEST(UrdfShared, Ur5LoadsWithItsWorldLinkMerged) {
+  REQUIRE_SHARED();
+  for (const char* f : {"ur5_robot.urdf", "ur5_joint_limited_robot.urdf"}) {
+    const Model m = load_robot(test::shared_models() / "ur5/urdf_example-robot-data/urdf" / f, no_meshes()).model;
+    EXPECT_EQ(m.nq(), 6) << f;
+    EXPECT_TRUE(m.is_serial_chain()) << f;
+    EXPECT_EQ(m.body_index("base_link"), 0) << f;
+    EXPECT_NEAR(m.total_mass(), 20.9939, 5e-5) << f;
+  }
+}
+
+TEST(UrdfShared, EveryUrdfLoadsExceptTheGazLwrWithItsNonPhysicalInertias) {
+  REQUIRE_SHARED();
+  int loaded = 0;
+  for (const auto& entry : fs::recursive_directory_iterator(test::shared_models())) {
+    if (entry.path().extension() != ".urdf") continue;
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("kuka_lwr4_gaz", 0) == 0) {
+      const std::string msg = load_error(entry.path(), no_meshes());
+      // lwr_1_link is the first link (in file order) whose inertia is not physical.
+      EXPECT_NE(msg.find("link 'lwr_1_link'"), std::string::npos) << name << ": " << msg;
+      EXPECT_NE(msg.find("not positive semi-definite"), std::string::npos) << name << ": " << msg;
+      EXPECT_NE(msg.find(name + ":"), std::string::npos) << msg;
+      continue;
+    }
+    EXPECT_NO_THROW((void)load_robot(entry.path(), no_meshes())) << name;
+    ++loaded;
+  }
+  EXPECT_EQ(loaded, 10);
+}
+
+TEST(UrdfShared, RelativeUrdfsLoadTheirMeshes) {
+  REQUIRE_SHARED();
+  LoadOptions o;
+  o.use_ros_package_path = false;
+  const RobotDescription panda = load_robot(panda_dir() / "urdf/panda.relative.urdf", o);
+  int meshes = 0;
+  for (const CollisionShape& s : panda.geometry.shapes) {
+    if (s.type != ShapeType::kMesh) continue;
+    ++meshes;
+    ASSERT_TRUE(s.mesh);
+    EXPECT_GT(s.mesh->triangles.cols(), 0) << s.mesh->path;
+  }
+  EXPECT_GT(meshes, 0);
+  EXPECT_NO_THROW((void)load_robot(lwr_dir() / "kuka_lwr4.relative.urdf", o));
+}
+
+TEST(UrdfShared, NominalLwrNeedsAMeshThatIsNotInTheRepository) {
+  REQUIRE_SHARED();
+  // kuka_lwr4.urdf loads without meshes; with meshes it names the missing convex mesh package.
+  EXPECT_NO_THROW((void)load_robot(lwr_dir() / "kuka_lwr4.urdf", no_meshes()));
+  LoadOptions o;
+  o.use_ros_package_path = false;
+  const std::string msg = load_error(lwr_dir() / "kuka_lwr4.urdf", o);
+  EXPECT_NE(msg.find("kuka_lwr4.urdf:"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("package 'lwr_description'"), std::string::npos) << msg;
+}
+
+class PackageDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!test::have_shared()) GTEST_SKIP() << "no shared models";
+    root_ = fs::temp_directory_path() / ("extwrench_pkg_" + std::to_string(::getpid()));
+    fs::create_directories(root_ / "example-robot-data/robots");
+    fs::create_directory_symlink(fs::absolute(panda_dir()), root_ / "example-robot-data/robots/panda_description");
+  }
+  void TearDown() override {
+    if (!root_.empty()) fs::remove_all(root_);
+  }
+  fs::path root_;
+};
+
+int loaded_meshes(const RobotDescription& r) {
+  int n = 0;
+  for (const CollisionShape& s : r.geometry.shapes) n += s.type == ShapeType::kMesh && s.mesh && s.mesh->triangles.cols() > 0;
+  return n;
+}
+
+TEST_F(PackageDir, PackageUrisResolveThroughTheOption) {
+  LoadOptions o;
+  o.use_ros_package_path = false;
+  o.package_path = {root_ / "nothing_here", root_};
+  const RobotDescription r = load_robot(panda_dir() / "urdf/panda.urdf", o);
+  EXPECT_GT(loaded_meshes(r), 0);
+}
+
+TEST_F(PackageDir, PackageUrisResolveThroughRosPackagePath) {
+  const char* old = std::getenv("ROS_PACKAGE_PATH");
+  const std::string saved = old ? old : "";
+  ::setenv("ROS_PACKAGE_PATH", ("/nonexistent:" + root_.string()).c_str(), 1);
+  LoadOptions o;
+  std::string err;
+  int n = 0;
+  try {
+    n = loaded_meshes(load_robot(panda_dir() / "urdf/panda.urdf", o));
+  } catch (const Error& e) {
+    err = e.what();
+  }
+  o.use_ros_package_path = false;
+  const std::string without = load_error(panda_dir() / "urdf/panda.urdf", o);
+  if (old) {
+    ::setenv("ROS_PACKAGE_PATH", saved.c_str(), 1);
+  } else {
+    ::unsetenv("ROS_PACKAGE_PATH");
+  }
+  EXPECT_EQ(err, "");
+  EXPECT_GT(n, 0);
+  EXPECT_NE(without.find("package 'example-robot-data'"), std::string::npos) << without;
+}
+
+// ---- against KDL built by its own parser (kdl_parser) -----------------------------------------
+
+Pose from_kdl(const KDL::Frame& f) {
+  Pose x;
+  for (int r = 0; r < 3; ++r) {
+    x.translation[r] = f.p(r);
+    for (int c = 0; c < 3; ++c) x.rotation(r, c) = f.M(r, c);
+  }
+  return x;
+}
+
+void compare_with_kdl(const fs::path& file) {
+  KDL::Tree tree;
+  ASSERT_TRUE(kdl_parser::treeFromFile(file.string(), tree)) << file;
+  const Model m = load_robot(file, no_meshes()).model;
+  ASSERT_EQ(static_cast<int>(tree.getNrOfJoints()), m.nq());
+  KDL::TreeFkSolverPos_recursive fk(tree);
+  test::SeededRng rng(7);
+  for (int trial = 0; trial < 5; ++trial) {
+    const VectorX q = rng.uniform_vector(m.nq(), -1.5, 1.5);
+    const auto X = test::body_poses(m, q);
+    KDL::JntArray qk(tree.getNrOfJoints());
+    for (const auto& [name, seg] : tree.getSegments()) {
+      const KDL::Joint& j = seg.segment.getJoint();
+      if (j.getType() == KDL::Joint::None) continue;
+      qk(seg.q_nr) = q[*m.find_joint(j.getName()) - 1];
+    }
+    // Every link: pose, and the world-frame mass properties of every moving body (KDL drops
+    // the root link's inertia, so body 0 is left out).
+    std::vector<KDL::RigidBodyInertia> body_inertia(static_cast<std::size_t>(m.num_bodies()), KDL::RigidBodyInertia::Zero());
+    for (const auto& [name, seg] : tree.getSegments()) {
+      if (name == tree.getRootSegment()->first) continue;
+      KDL::Frame f;
+      ASSERT_GE(fk.JntToCart(qk, f, name), 0);
+      const Pose ours = test::world_frame_pose(m, X, name);
+      EXPECT_TRUE(ours.is_approx(from_kdl(f), 1e-9)) << file.filename() << " link " << name;
+      body_inertia[static_cast<std::size_t>(*m.find_body(name))] =
+          body_inertia[static_cast<std::size_t>(*m.find_body(name))] + f * seg.segment.getInertia();
+    }
+    for (int b = 1; b < m.num_bodies(); ++b) {
+      const KDL::RigidBodyInertia& k = body_inertia[static_cast<std::size_t>(b)];
+      const Inertia w = m.bodies[static_cast<std::size_t>(b)].inertia.transformed(X[static_cast<std::size_t>(b)]);
+      EXPECT_NEAR(w.mass, k.getMass(), 1e-9);
+      if (k.getMass() > 0) {
+        for (int i = 0; i < 3; ++i) EXPECT_NEAR(w.com[i], k.getCOG()(i), 1e-9) << file.filename() << " body " << b;
+      }
+      // KDL's rotational inertia is about the reference (world) origin.
+      const Matrix3 about_origin =
+          w.inertia_com + w.mass * (w.com.squaredNorm() * Matrix3::Identity() - w.com * w.com.transpose());
+      const KDL::RotationalInertia ki = k.getRotationalInertia();
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(about_origin(r, c), ki.data[3 * r + c], 1e-9) << file.filename() << " body " << b;
+      }
+    }
+  }
+}
+
+TEST(UrdfShared, PandaKinematicsAndMergedInertiasMatchKdl) {
+  REQUIRE_SHARED();
+  compare_with_kdl(panda_dir() / "urdf/panda.urdf");
+}
+
+TEST(UrdfShared, Ur5AndLwrKinematicsAndMergedInertiasMatchKdl) {
+  REQUIRE_SHARED();
+  compare_with_kdl(test::shared_models() / "ur5/urdf_example-robot-data/urdf/ur5_robot.urdf");
+  compare_with_kdl(lwr_dir() / "kuka_lwr4.urdf");
+}
+
+}  // namespace
+}  // namespace extwrench
