@@ -1,0 +1,229 @@
+#include "robots.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/tree.hpp>
+#include <kdl_parser/kdl_parser.hpp>
+
+#include "extwrench/dynamics/data.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/io/robot_loader.hpp"
+
+namespace extwrench::bench {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+// SPEC §5: standard DH, a_i = 0, θ_i = q_i.
+constexpr double kAlpha[7] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0};
+constexpr double kD[7] = {0, 0, 0.40, 0, 0.39, 0, 0.078};
+constexpr double kMass[7] = {2.7, 2.7, 2.7, 2.7, 2.7, 1.7, 0.3};
+constexpr double kComCm[7][3] = {{0.1340, -8.7777, 2.6220}, {0.1340, 2.6220, 8.7777},
+                                 {0.1340, 8.7777, 2.6220},  {0.1340, 2.6220, 8.7777},
+                                 {0.1340, -8.7777, 2.6220}, {0, 0.5, 0},
+                                 {0, 0, -2.0}};
+// Ixx Ixy Ixz Iyy Iyz Izz [g m^2], about the CoM, DH frame i axes.
+constexpr double kInertia[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
+                                   {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
+                                   {16.341, 0.003, 0.001, 5.026, 3.533, 16.173},
+                                   {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
+                                   {16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
+                                   {5.0, 0, 0, 3.6, 0, 4.7},
+                                   {1.0, 0, 0, 1.0, 0, 1.0}};
+constexpr double kLink0Height = 0.31;  // O_0 = O_s + (0, 0, 0.31)
+
+Pose dh_pose(double d, double alpha) {  // Tz(d) Rx(alpha); the Rz(q) is the joint's motion
+  Pose x;
+  x.translation = Vector3(0, 0, d);
+  x.rotation = Eigen::AngleAxisd(alpha, Vector3::UnitX()).toRotationMatrix();
+  return x;
+}
+
+// Body i's frame is DH frame i-1 turned by q_i (z = joint i's axis), as a URDF would place it.
+Model paper_arm_model_from_dh() {
+  Model m;
+  m.name = "paper_arm";
+  m.bodies.resize(8);
+  m.joints.resize(8);
+  m.parents.resize(8);
+  m.parents[0] = -1;
+  m.bodies[0].name = "link0";
+  m.bodies[0].inertia.mass = 2.0;
+  m.bodies[0].inertia.com = Vector3(0, 0, 0.15);
+  m.bodies[0].inertia.inertia_com = Vector3(0.020, 0.020, 0.010).asDiagonal();
+  m.frames.push_back({"link0", 0, Pose{}});
+  for (int i = 1; i <= 7; ++i) {
+    const int k = i - 1;
+    m.parents[i] = i - 1;
+    Joint& j = m.joints[i];
+    j.name = "joint" + std::to_string(i);
+    j.axis = Vector3::UnitZ();
+    j.placement = i == 1 ? dh_pose(kLink0Height, 0.0) : dh_pose(kD[k - 1], kAlpha[k - 1]);
+    Inertia in_dh;
+    in_dh.mass = kMass[k];
+    in_dh.com = Vector3(kComCm[k][0], kComCm[k][1], kComCm[k][2]) * 1e-2;
+    const double* c = kInertia[k];
+    in_dh.inertia_com << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
+    in_dh.inertia_com *= 1e-3;
+    m.bodies[i].name = "link" + std::to_string(i);
+    m.bodies[i].inertia = in_dh.transformed(dh_pose(kD[k], kAlpha[k]));
+    m.frames.push_back({m.bodies[i].name, i, Pose{}});
+  }
+  return m;
+}
+
+KDL::Chain paper_arm_chain_from_dh() {
+  KDL::Chain chain;
+  chain.addSegment(KDL::Segment("link0", KDL::Joint(KDL::Joint::None),
+                                KDL::Frame(KDL::Vector(0, 0, kLink0Height))));
+  for (int k = 0; k < 7; ++k) {
+    const double* c = kInertia[k];
+    // KDL: inertia in the segment's tip frame (DH frame i), rotational part about the CoM.
+    const KDL::RotationalInertia I(c[0] * 1e-3, c[3] * 1e-3, c[5] * 1e-3, c[1] * 1e-3,
+                                   c[2] * 1e-3, c[4] * 1e-3);
+    const KDL::Vector com(kComCm[k][0] * 1e-2, kComCm[k][1] * 1e-2, kComCm[k][2] * 1e-2);
+    chain.addSegment(KDL::Segment("link" + std::to_string(k + 1), KDL::Joint(KDL::Joint::RotZ),
+                                  KDL::Frame::DH(0.0, kAlpha[k], kD[k], 0.0),
+                                  KDL::RigidBodyInertia(kMass[k], com, I)));
+  }
+  return chain;
+}
+
+// One capsule per body from its origin to the next joint's origin (the flange gets the DH d_7
+// segment), spheres where that length is zero; used when the robot file has no collision shapes.
+GeometryModel capsules(const Model& model) {
+  const double radius[8] = {0.08, 0.07, 0.07, 0.06, 0.065, 0.055, 0.06, 0.04};
+  GeometryModel g;
+  g.body_shapes.resize(static_cast<std::size_t>(model.num_bodies()));
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const Vector3 end = b + 1 < model.num_bodies() ? model.joints[b + 1].placement.translation
+                                                   : Vector3(0, 0, kD[6]);
+    CollisionShape s;
+    s.body = b;
+    s.link = model.bodies[b].name;
+    s.radius = radius[std::min(b, 7)];
+    if (end.norm() > 1e-9) {
+      s.type = ShapeType::kCapsule;
+      s.length = end.norm();
+      s.placement.rotation =
+          Eigen::Quaterniond::FromTwoVectors(Vector3::UnitZ(), end.normalized()).toRotationMatrix();
+      s.placement.translation = 0.5 * end;
+    } else {
+      s.type = ShapeType::kSphere;
+    }
+    g.body_shapes[b].push_back(static_cast<int>(g.shapes.size()));
+    g.shapes.push_back(s);
+  }
+  return g;
+}
+
+bool has_shapes(const GeometryModel& g, int nb) {
+  if (static_cast<int>(g.body_shapes.size()) != nb) return false;
+  for (const auto& s : g.body_shapes) {
+    if (s.empty()) return false;
+  }
+  return true;
+}
+
+PaperArm load_paper_arm() {
+  PaperArm arm;
+  const std::filesystem::path urdf = std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf";
+  if (std::filesystem::exists(urdf)) {
+    RobotDescription robot = load_urdf(urdf);
+    arm.model = std::move(robot.model);
+    arm.geometry = std::move(robot.geometry);
+    KDL::Tree tree;
+    if (!kdl_parser::treeFromFile(urdf.string(), tree)) {
+      throw std::runtime_error("kdl_parser could not read " + urdf.string());
+    }
+    // Tip: the deepest URDF link welded to the last body (a flange frame if there is one),
+    // so that KDL's chain carries the same mass as our merged body.
+    const int last = arm.model.nq();
+    std::string tip = arm.model.bodies[last].name;
+    for (const Frame& f : arm.model.frames) {
+      if (f.body == last && tree.getSegments().count(f.name) > 0) tip = f.name;
+    }
+    if (!tree.getChain(tree.getRootSegment()->first, tip, arm.chain)) {
+      throw std::runtime_error("KDL: no chain from the root to " + tip + " in " + urdf.string());
+    }
+    arm.source = "models/paper_arm.urdf (ours: load_urdf; KDL: kdl_parser::treeFromFile)";
+  } else {
+    arm.model = paper_arm_model_from_dh();
+    arm.chain = paper_arm_chain_from_dh();
+    arm.source = "SPEC 5 DH table in code (ours: Model; KDL: Frame::DH)";
+  }
+  if (!has_shapes(arm.geometry, arm.model.num_bodies())) arm.geometry = capsules(arm.model);
+  return arm;
+}
+
+void check_same_robot(const PaperArm& arm, const StatePool& pool) {
+  Data data(arm.model);
+  KDL::ChainIdSolver_RNE rne(arm.chain, KDL::Vector(arm.model.gravity.x(), arm.model.gravity.y(),
+                                                    arm.model.gravity.z()));
+  const int n = arm.model.nq();
+  if (static_cast<int>(arm.chain.getNrOfJoints()) != n) {
+    throw std::runtime_error("KDL chain and model have different joint counts");
+  }
+  KDL::Wrenches none(arm.chain.getNrOfSegments(), KDL::Wrench::Zero());
+  KDL::JntArray tau(static_cast<unsigned>(n));
+  for (std::size_t k = 0; k < 16; ++k) {
+    rnea(arm.model, data, pool.q[k], pool.dq[k], pool.ddq[k]);
+    if (rne.CartToJnt(pool.kq[k], pool.kdq[k], pool.kddq[k], none, tau) != 0) {
+      throw std::runtime_error("KDL RNE failed");
+    }
+    const double err = (data.tau - tau.data).cwiseAbs().maxCoeff();
+    if (!(err < 1e-9 * (1.0 + tau.data.cwiseAbs().maxCoeff()))) {
+      throw std::runtime_error("KDL and extwrench disagree on the paper arm's RNE by " +
+                               std::to_string(err) + " N m: not the same robot");
+    }
+  }
+}
+
+StatePool make_state_pool(int n) {
+  StatePool pool;
+  std::mt19937 rng(20160927u);  // fixed seed: the same states in every run and on both sides
+  auto vec = [&](double lo, double hi) {
+    std::uniform_real_distribution<double> u(lo, hi);
+    VectorX v(n);
+    for (int i = 0; i < n; ++i) v[i] = u(rng);
+    return v;
+  };
+  auto kdl = [&](const VectorX& v) {
+    KDL::JntArray a(static_cast<unsigned>(n));
+    a.data = v;
+    return a;
+  };
+  for (std::size_t k = 0; k < StatePool::kNumStates; ++k) {
+    pool.q.push_back(vec(-2.0, 2.0));
+    pool.dq.push_back(vec(-1.5, 1.5));
+    pool.ddq.push_back(vec(-3.0, 3.0));
+    pool.tau.push_back(vec(-20.0, 20.0));
+    pool.kq.push_back(kdl(pool.q.back()));
+    pool.kdq.push_back(kdl(pool.dq.back()));
+    pool.kddq.push_back(kdl(pool.ddq.back()));
+    pool.ktau.push_back(kdl(pool.tau.back()));
+  }
+  return pool;
+}
+
+}  // namespace
+
+const PaperArm& paper_arm() {
+  static const PaperArm arm = [] {
+    PaperArm a = load_paper_arm();
+    check_same_robot(a, make_state_pool(a.model.nq()));
+    return a;
+  }();
+  return arm;
+}
+
+const StatePool& state_pool() {
+  static const StatePool pool = make_state_pool(paper_arm().model.nq());
+  return pool;
+}
+
+}  // namespace extwrench::bench
