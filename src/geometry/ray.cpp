@@ -77,8 +77,8 @@ class HitSink {
 
 // ---- primitives (shape frame; o = point on the line, u = unit direction) ---------------------
 
-void sphere_hits(double r, const Vector3& c, const Vector3& o, const Vector3& u,
-                 ShapeHit* out, int& n) noexcept {
+void sphere_hits(double r, const Vector3& c, const Vector3& o, const Vector3& u, ShapeHit* out,
+                 int& n) noexcept {
   // |o + λu − c|² = r²: from the foot of the perpendicular f (λ₀ = u·(c − o)), λ = λ₀ ± h with
   // h² = r² − |f − c|², which keeps its precision for lines far from the centre.
   const double l0 = u.dot(c - o);
@@ -106,8 +106,14 @@ int box_hits(const Vector3& half, const Vector3& o, const Vector3& u, ShapeHit* 
     double t1 = (-half[i] - o[i]) / u[i];
     double t2 = (half[i] - o[i]) / u[i];
     if (t1 > t2) std::swap(t1, t2);
-    if (t1 > t_near) { t_near = t1; i_near = i; }
-    if (t2 < t_far) { t_far = t2; i_far = i; }
+    if (t1 > t_near) {
+      t_near = t1;
+      i_near = i;
+    }
+    if (t2 < t_far) {
+      t_far = t2;
+      i_far = i;
+    }
   }
   if (i_near < 0 || i_far < 0 || !(t_near <= t_far)) return 0;
   // Entry through the face the direction points into, exit through the opposite one; the face
@@ -127,7 +133,8 @@ int box_hits(const Vector3& half, const Vector3& o, const Vector3& u, ShapeHit* 
 
 /// λ interval where the line is inside the infinite cylinder x² + y² ≤ r². False if never.
 /// A line along the axis (u_xy = 0) gives (−inf, inf) when inside.
-bool lateral_interval(double r, const Vector3& o, const Vector3& u, double& t1, double& t2) noexcept {
+bool lateral_interval(double r, const Vector3& o, const Vector3& u, double& t1,
+                      double& t2) noexcept {
   const double rho_u = std::hypot(u.x(), u.y());
   if (rho_u < kTinyComponent) {
     if (o.x() * o.x() + o.y() * o.y() > r * r) return false;
@@ -165,8 +172,14 @@ int cylinder_hits(double r, double hl, const Vector3& o, const Vector3& u, Shape
     double z1 = (-hl - o.z()) / u.z();
     double z2 = (hl - o.z()) / u.z();
     if (z1 > z2) std::swap(z1, z2);
-    if (z1 > t_near) { t_near = z1; near_cap = true; }
-    if (z2 < t_far) { t_far = z2; far_cap = true; }
+    if (z1 > t_near) {
+      t_near = z1;
+      near_cap = true;
+    }
+    if (z2 < t_far) {
+      t_far = z2;
+      far_cap = true;
+    }
   }
   if (!(t_near <= t_far) || !std::isfinite(t_near) || !std::isfinite(t_far)) return 0;
   const auto cap_hit = [&](double t, double sign) {
@@ -262,7 +275,8 @@ void visit_candidate(void* user, int tri) noexcept {
   }
 }
 
-void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u, HitSink& sink) noexcept {
+void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u,
+               HitSink& sink) noexcept {
   if (mesh.ray_caster == nullptr) {
     ShapeHit hit;
     for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
@@ -331,7 +345,8 @@ Vector3 segment_closest_to_line(const Vector3& a, const Vector3& b, const Vector
 /// lies within the bounding sphere's shadow [λ_c − R, λ_c + R] (the optimal segment between the
 /// line and the solid is perpendicular to the line).
 template <class Project>
-ShapeClosestPoint golden_closest(const Vector3& o, const Vector3& u, double bound, Project&& project) noexcept {
+ShapeClosestPoint golden_closest(const Vector3& o, const Vector3& u, double bound,
+                                 Project&& project) noexcept {
   const auto f = [&](double l) {
     const Vector3 p = o + l * u;
     return (p - project(p)).norm();
@@ -364,7 +379,8 @@ ShapeClosestPoint golden_closest(const Vector3& o, const Vector3& u, double boun
   return cp;
 }
 
-ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o, const Vector3& u) noexcept {
+ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o,
+                                  const Vector3& u) noexcept {
   ShapeClosestPoint cp;
   switch (shape.type) {
     case ShapeType::kSphere: {
@@ -382,7 +398,8 @@ ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o,
                                                 cp.lambda, axis_distance);
       const Vector3 to_line = o + cp.lambda * u - q;
       const double n = to_line.norm();
-      cp.point = q + (n > 0.0 ? Vector3(shape.radius / n * to_line) : Vector3(shape.radius * Vector3::UnitX()));
+      cp.point = q + (n > 0.0 ? Vector3(shape.radius / n * to_line)
+                              : Vector3(shape.radius * Vector3::UnitX()));
       cp.distance = std::max(axis_distance - shape.radius, 0.0);
       return cp;
     }
@@ -410,8 +427,9 @@ ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o,
       for (Eigen::Index t = 0; t < m.triangles.cols(); ++t) {
         for (int k = 0; k < 3; ++k) {
           double l = 0.0, d = 0.0;
-          const Vector3 q = segment_closest_to_line(m.vertices.col(m.triangles(k, t)),
-                                                    m.vertices.col(m.triangles((k + 1) % 3, t)), o, u, l, d);
+          const Vector3 q =
+              segment_closest_to_line(m.vertices.col(m.triangles(k, t)),
+                                      m.vertices.col(m.triangles((k + 1) % 3, t)), o, u, l, d);
           if (d < cp.distance) {
             cp.distance = d;
             cp.point = q;
@@ -449,8 +467,8 @@ ShapeClosestPoint closest_point_to_line(const CollisionShape& shape, const Vecto
   return closest_on_miss(shape, origin_S, direction_S);
 }
 
-SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int body, const Pose& X_WB,
-                                            const Vector3& point_on_line_W,
+SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int body,
+                                            const Pose& X_WB, const Vector3& point_on_line_W,
                                             const Vector3& direction_W) noexcept {
   SurfacePointResult result;
   const LineHit none{kNaN, Vector3::Constant(kNaN), Vector3::Constant(kNaN), -1};
@@ -495,8 +513,10 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
       if (is_mesh && orient * w.normal_W.dot(u_W) < 0.0) w.normal_W = -w.normal_W;
       return w;
     };
-    if (!result.hit || sink.first().lambda < result.entry.lambda) result.entry = to_world(sink.first(), -1.0);
-    if (!result.hit || sink.last().lambda > result.exit.lambda) result.exit = to_world(sink.last(), 1.0);
+    if (!result.hit || sink.first().lambda < result.entry.lambda)
+      result.entry = to_world(sink.first(), -1.0);
+    if (!result.hit || sink.last().lambda > result.exit.lambda)
+      result.exit = to_world(sink.last(), 1.0);
     result.hit = true;
   }
 

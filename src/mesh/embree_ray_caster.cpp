@@ -72,7 +72,8 @@ class EmbreeRayCaster final : public MeshRayCaster {
   EmbreeRayCaster(const Matrix3X& vertices, const Eigen::Matrix<int, 3, Eigen::Dynamic>& triangles,
                   const std::string& name)
       : device_(Device::shared()) {
-    if (vertices.cols() == 0 || triangles.cols() == 0) throw Error(name + ": mesh has no triangles");
+    if (vertices.cols() == 0 || triangles.cols() == 0)
+      throw Error(name + ": mesh has no triangles");
     // Float vertices relative to the box centre: the float error then scales with the mesh size,
     // not with its distance from the origin.
     lower_ = vertices.rowwise().minCoeff();
@@ -83,18 +84,19 @@ class EmbreeRayCaster final : public MeshRayCaster {
     RTCDevice device = device_->get();
     scene_.reset(rtcNewScene(device));
     if (scene_ == nullptr) throw error(name, "rtcNewScene");
-    rtcSetSceneFlags(scene_.get(), RTC_SCENE_FLAG_ROBUST);  // watertight: no ray slips through an edge
+    rtcSetSceneFlags(scene_.get(),
+                     RTC_SCENE_FLAG_ROBUST);  // watertight: no ray slips through an edge
     rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_HIGH);
 
     const std::unique_ptr<RTCGeometryTy, GeometryDeleter> geometry(
         rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE));
     if (geometry == nullptr) throw error(name, "rtcNewGeometry");
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0,
-                                                           RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                           static_cast<std::size_t>(vertices.cols())));
-    auto* ib = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0,
-                                                              RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
-                                                              static_cast<std::size_t>(triangles.cols())));
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), static_cast<std::size_t>(vertices.cols())));
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(unsigned), static_cast<std::size_t>(triangles.cols())));
     if (vb == nullptr || ib == nullptr) throw error(name, "rtcSetNewGeometryBuffer");
     for (Eigen::Index v = 0; v < vertices.cols(); ++v) {
       for (int k = 0; k < 3; ++k) vb[3 * v + k] = static_cast<float>(vertices(k, v) - centre_[k]);
@@ -108,7 +110,6 @@ class EmbreeRayCaster final : public MeshRayCaster {
     rtcCommitScene(scene_.get());
     if (rtcGetDeviceError(device) != RTC_ERROR_NONE) throw error(name, "building the scene");
   }
-
 
   void for_each_line_candidate(const Vector3& origin, const Vector3& direction, Visitor visit,
                                void* user) const noexcept override {

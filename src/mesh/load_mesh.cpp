@@ -38,18 +38,19 @@ void collect(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent
                                   offset + static_cast<int>(face.mIndices[2]));
     }
   }
-  for (unsigned c = 0; c < node.mNumChildren; ++c) collect(scene, *node.mChildren[c], transform, soup);
+  for (unsigned c = 0; c < node.mNumChildren; ++c)
+    collect(scene, *node.mChildren[c], transform, soup);
 }
 
 }  // namespace
 
-std::shared_ptr<const TriangleMesh> make_triangle_mesh(Matrix3X vertices,
-                                                       Eigen::Matrix<int, 3, Eigen::Dynamic> triangles,
-                                                       const std::string& name) {
+std::shared_ptr<const TriangleMesh> make_triangle_mesh(
+    Matrix3X vertices, Eigen::Matrix<int, 3, Eigen::Dynamic> triangles, const std::string& name) {
   if (triangles.cols() == 0) throw Error(name + ": mesh has no triangles");
   if (!vertices.allFinite()) throw Error(name + ": mesh has a non-finite vertex coordinate");
   if (triangles.minCoeff() < 0 || triangles.maxCoeff() >= vertices.cols()) {
-    throw Error(name + ": triangle vertex index out of range [0, " + std::to_string(vertices.cols()) + ")");
+    throw Error(name + ": triangle vertex index out of range [0, " +
+                std::to_string(vertices.cols()) + ")");
   }
   auto mesh = std::make_shared<TriangleMesh>();
   mesh->path = name;
@@ -59,15 +60,18 @@ std::shared_ptr<const TriangleMesh> make_triangle_mesh(Matrix3X vertices,
   return mesh;
 }
 
-std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& path, const Vector3& scale) {
+std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& path,
+                                              const Vector3& scale) {
   const std::string name = path.string();
   if (!scale.allFinite() || (scale.array() == 0.0).any()) {
     throw Error(name + ": mesh scale must be finite and non-zero");
   }
   Assimp::Importer importer;
-  // URDF tools read Collada in the file's own axes.
+  // URDF tools read Collada in the file's own axes. Normals are dropped (they come from the
+  // winding) so that vertices are joined by position alone.
   importer.SetPropertyBool(AI_CONFIG_IMPORT_COLLADA_IGNORE_UP_DIRECTION, true);
-  const aiScene* scene = importer.ReadFile(name, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices);
+  const aiScene* scene = importer.ReadFile(
+      name, aiProcess_Triangulate | aiProcess_DropNormals | aiProcess_JoinIdenticalVertices);
   if (scene == nullptr || scene->mRootNode == nullptr) {
     throw Error(name + ": cannot read mesh: " + importer.GetErrorString());
   }
@@ -79,7 +83,8 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& path,
   for (std::size_t i = 0; i < soup.vertices.size(); ++i) {
     vertices.col(static_cast<Eigen::Index>(i)) = soup.vertices[i].cwiseProduct(scale);
   }
-  Eigen::Matrix<int, 3, Eigen::Dynamic> triangles(3, static_cast<Eigen::Index>(soup.triangles.size()));
+  Eigen::Matrix<int, 3, Eigen::Dynamic> triangles(3,
+                                                  static_cast<Eigen::Index>(soup.triangles.size()));
   for (std::size_t i = 0; i < soup.triangles.size(); ++i) {
     triangles.col(static_cast<Eigen::Index>(i)) = soup.triangles[i];
   }

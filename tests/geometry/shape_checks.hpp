@@ -81,11 +81,16 @@ inline double distance_to_solid(const CollisionShape& s, const Vector3& p) {
 /// Radius of a ball about the origin containing the shape.
 inline double bounding_radius(const CollisionShape& s) {
   switch (s.type) {
-    case ShapeType::kSphere: return s.radius;
-    case ShapeType::kBox: return 0.5 * s.size.norm();
-    case ShapeType::kCylinder: return std::hypot(s.radius, 0.5 * s.length);
-    case ShapeType::kCapsule: return s.radius + 0.5 * s.length;
-    case ShapeType::kMesh: break;
+    case ShapeType::kSphere:
+      return s.radius;
+    case ShapeType::kBox:
+      return 0.5 * s.size.norm();
+    case ShapeType::kCylinder:
+      return std::hypot(s.radius, 0.5 * s.length);
+    case ShapeType::kCapsule:
+      return s.radius + 0.5 * s.length;
+    case ShapeType::kMesh:
+      break;
   }
   return NAN;
 }

@@ -138,13 +138,19 @@ double sampled_line_distance(const CollisionShape& s, const Vector3& o, const Ve
   for (int i = 0; i <= n; ++i) {
     const double l = -r + 2.0 * r * i / n;
     const double d = test::distance_to_solid(s, o + l * u);
-    if (d < best) { best = d; best_l = l; }
+    if (d < best) {
+      best = d;
+      best_l = l;
+    }
   }
   double step = 2.0 * r / n;
   for (int k = 0; k < 60; ++k) {
     for (const double l : {best_l - step, best_l + step}) {
       const double d = test::distance_to_solid(s, o + l * u);
-      if (d < best) { best = d; best_l = l; }
+      if (d < best) {
+        best = d;
+        best_l = l;
+      }
     }
     step *= 0.7;
   }
@@ -241,9 +247,12 @@ TEST(RayPrimitives, LinesAlongTheAxisHitCylinderCapsAndCapsulePoles) {
   EXPECT_EQ(hits[1].point.z(), -0.3);
   EXPECT_EQ(hits[1].normal, -Vector3::UnitZ());
   // Outside the radius, parallel to the axis: no hit.
-  EXPECT_EQ(intersect_line_with_shape(test::make_cylinder(0.15, 0.6), Vector3(0.2, 0.0, 0.0), u, hits), 0);
+  EXPECT_EQ(
+      intersect_line_with_shape(test::make_cylinder(0.15, 0.6), Vector3(0.2, 0.0, 0.0), u, hits),
+      0);
   // Capsule along its axis: the poles at ±(L/2 + r).
-  ASSERT_EQ(intersect_line_with_shape(test::make_capsule(0.1, 0.5), Vector3(0.0, 0.0, 3.0), u, hits), 2);
+  ASSERT_EQ(
+      intersect_line_with_shape(test::make_capsule(0.1, 0.5), Vector3(0.0, 0.0, 3.0), u, hits), 2);
   EXPECT_NEAR(hits[0].point.z(), 0.35, 1e-15);
   EXPECT_NEAR(hits[1].point.z(), -0.35, 1e-15);
   EXPECT_LT((hits[0].normal - Vector3::UnitZ()).norm(), 1e-15);

@@ -19,7 +19,7 @@ namespace extwrench {
 
 /// One intersection of a line with the surface of a shape, in the shape frame S.
 struct ShapeHit {
-  double lambda = 0.0;             ///< λ [m] along the unit direction
+  double lambda = 0.0;               ///< λ [m] along the unit direction
   Vector3 point = Vector3::Zero();   ///< p_S: the surface point p(λ)
   Vector3 normal = Vector3::Zero();  ///< outward unit normal (meshes: from the triangle's winding)
 };
@@ -54,25 +54,25 @@ struct ShapeClosestPoint {
 
 /// One intersection of the line with a body's surface, in the world frame W.
 struct LineHit {
-  double lambda = 0.0;                  ///< λ [m] along the unit direction
-  Vector3 point_W = Vector3::Zero();    ///< p(λ) on the surface
-  Vector3 normal_W = Vector3::Zero();   ///< outward unit normal
-  int shape = -1;                       ///< index into GeometryModel::shapes
+  double lambda = 0.0;                 ///< λ [m] along the unit direction
+  Vector3 point_W = Vector3::Zero();   ///< p(λ) on the surface
+  Vector3 normal_W = Vector3::Zero();  ///< outward unit normal
+  int shape = -1;                      ///< index into GeometryModel::shapes
 };
 
 /// Result of intersect_line_with_body. On failure or miss, entry/exit are NaN with shape −1.
 struct SurfacePointResult {
-  bool hit = false;      ///< the line crosses (or touches) a shape of the body
-  int num_hits = 0;      ///< intersections over all shapes (2 for one convex shape)
-  LineHit entry;         ///< smallest λ: the pushing point (21)
-  LineHit exit;          ///< largest λ: the pulling point
+  bool hit = false;  ///< the line crosses (or touches) a shape of the body
+  int num_hits = 0;  ///< intersections over all shapes (2 for one convex shape)
+  LineHit entry;     ///< smallest λ: the pushing point (21)
+  LineHit exit;      ///< largest λ: the pulling point
   /// Hit: the entry point, distance 0. Miss: the surface point nearest to the line, with the
   /// line's λ there and the distance [m] (+inf if the body has no usable shape; NaN if the
   /// direction is zero or an input is not finite).
   Vector3 closest_point_W = Vector3::Zero();
   double closest_lambda = 0.0;
   double distance = 0.0;
-  int shape = -1;        ///< shape of closest_point_W
+  int shape = -1;  ///< shape of closest_point_W
 };
 
 /// Intersects the line p(λ) = point_on_line_W + λ direction_W/‖direction_W‖ (21) with every
