@@ -1,0 +1,54 @@
+// The extwrench command-line tool: one file per subcommand, each exposing a register function
+// that adds the subcommand, its options and its callback to the app (main.cpp lists them).
+// Subcommands parse, call the library and print; the library does the work.
+//
+// Exit codes: 0 success, 1 an input problem (a file that cannot be read or is malformed: the
+// callback throws extwrench::Error), 2 a usage problem (the command line itself: CLI11 parse
+// errors, or UsageError thrown by a callback).
+#pragma once
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "extwrench/core/types.hpp"
+#include "extwrench/io/robot_loader.hpp"
+
+namespace extwrench::cli {
+
+/// A command line that cannot work, found after parsing (e.g. --sensor-pose "1 2"): exit 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+void register_info(CLI::App& app);
+void register_dynamics(CLI::App& app);
+
+// ---- helpers shared by subcommands (common.cpp) --------------------------------------------
+
+/// "x y z roll pitch yaw" (metres, radians; URDF's fixed-axis rpy; spaces or commas between
+/// the six numbers) as a Pose. Throws UsageError naming `option` otherwise.
+[[nodiscard]] Pose parse_pose(const std::string& text, const std::string& option);
+
+/// Adds `--package-path DIR` (repeatable) for package:// URIs to a subcommand.
+void add_package_path_option(CLI::App& sub, std::vector<std::filesystem::path>& dirs);
+
+/// Loads a URDF or DH YAML with those package directories (and ROS_PACKAGE_PATH).
+[[nodiscard]] RobotDescription load_robot_file(const std::filesystem::path& path,
+                                               const std::vector<std::filesystem::path>& package_path);
+
+/// The base sensor pose X_WS used when none is given: the frame named "sensor" if the model
+/// has one (it must be on link 0), else the root link's origin, aligned with it.
+/// `description` says which, for messages.
+[[nodiscard]] Pose default_sensor_pose(const Model& model, std::string* description);
+
+/// Number for humans: up to 10 significant digits ("17.9", "-0.0875", "1e-06").
+[[nodiscard]] std::string fmt(double value);
+/// "(x, y, z)" with fmt.
+[[nodiscard]] std::string fmt(const Vector3& v);
+
+}  // namespace extwrench::cli

@@ -1,0 +1,146 @@
+// extwrench dynamics: inverse dynamics and the predicted base sensor reading for each row of a
+// CSV of states (SPEC 3).
+#include <algorithm>
+#include <iostream>
+#include <memory>
+#include <optional>
+
+#include "commands.hpp"
+#include "extwrench/core/error.hpp"
+#include "extwrench/dynamics/data.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/io/csv.hpp"
+
+namespace extwrench::cli {
+namespace {
+
+struct DynamicsOptions {
+  std::filesystem::path robot;
+  std::string sensor_pose;
+  std::string in;
+  std::string out;
+  std::vector<std::filesystem::path> package_path;
+};
+
+/// Columns of the input for an n-joint robot: t, q1..qn, dq1..dqn, ddq1..ddqn.
+std::vector<std::string> state_columns(int n) {
+  std::vector<std::string> names{"t"};
+  for (const char* prefix : {"q", "dq", "ddq"}) {
+    for (int i = 1; i <= n; ++i) names.push_back(prefix + std::to_string(i));
+  }
+  return names;
+}
+
+std::vector<std::string> output_columns(int n) {
+  std::vector<std::string> names{"t"};
+  for (int i = 1; i <= n; ++i) names.push_back("tau" + std::to_string(i));
+  for (const char* s : {"fs_x", "fs_y", "fs_z", "ms_x", "ms_y", "ms_z"}) names.emplace_back(s);
+  return names;
+}
+
+void run_dynamics(const DynamicsOptions& opt) {
+  // Check the command line before any file is touched: a usage error is reported first.
+  std::optional<Pose> given_pose;
+  if (!opt.sensor_pose.empty()) given_pose = parse_pose(opt.sensor_pose, "--sensor-pose");
+
+  const RobotDescription robot = load_robot_file(opt.robot, opt.package_path);
+  const Model& model = robot.model;
+  const int n = model.nq();
+  const Pose X_WS = given_pose ? *given_pose : default_sensor_pose(model, nullptr);
+
+  std::unique_ptr<CsvReader> reader = opt.in == "-" ? std::make_unique<CsvReader>(std::cin, "<stdin>")
+                                                    : std::make_unique<CsvReader>(std::filesystem::path(opt.in));
+
+  // Resolve every column once; report all that are missing together.
+  const std::vector<std::string> wanted = state_columns(n);
+  std::vector<int> index;
+  std::string missing;
+  for (const std::string& name : wanted) {
+    const auto c = reader->find_column(name);
+    if (!c) missing += (missing.empty() ? "" : ", ") + name;
+    index.push_back(c.value_or(-1));
+  }
+  if (!missing.empty()) {
+    throw Error(reader->name() + ":1: missing column(s) " + missing + " (the robot has " + std::to_string(n) +
+                " joints, so the header needs t, q1..q" + std::to_string(n) + ", dq1..dq" + std::to_string(n) +
+                ", ddq1..ddq" + std::to_string(n) + ")");
+  }
+  std::string extra;
+  for (const std::string& name : reader->header()) {
+    if (std::find(wanted.begin(), wanted.end(), name) == wanted.end()) extra += (extra.empty() ? "" : ", ") + name;
+  }
+  if (!extra.empty()) std::cerr << "extwrench dynamics: ignoring column(s) " << extra << "\n";
+
+  std::unique_ptr<CsvWriter> writer =
+      opt.out == "-" ? std::make_unique<CsvWriter>(std::cout, output_columns(n), "<stdout>")
+                     : std::make_unique<CsvWriter>(std::filesystem::path(opt.out), output_columns(n));
+
+  Data data(model);
+  VectorX q(n), dq(n), ddq(n);
+  const auto at = [&](int k) { return index[static_cast<std::size_t>(k)]; };
+  try {
+    while (reader->next_row()) {
+      const double t = reader->number(at(0));
+      for (int i = 0; i < n; ++i) {
+        q[i] = reader->number(at(1 + i));
+        dq[i] = reader->number(at(1 + n + i));
+        ddq[i] = reader->number(at(1 + 2 * n + i));
+      }
+      const VectorX& tau = rnea(model, data, q, dq, ddq);
+      const Vector6 reading = sensor_reading(data, X_WS);  // [f_m; n_m] in S, about O_s (SPEC 3)
+      writer->add(t);
+      for (int i = 0; i < n; ++i) writer->add(tau[i]);
+      for (int k = 0; k < 6; ++k) writer->add(reading[k]);
+      writer->end_row();
+    }
+  } catch (const Error&) {
+    // Leave no half-written output that could be mistaken for a result.
+    writer.reset();
+    if (opt.out != "-") {
+      std::error_code ignored;
+      std::filesystem::remove(opt.out, ignored);
+    }
+    throw;
+  }
+  writer->close();
+  if (opt.out != "-") {
+    std::cerr << "extwrench dynamics: " << reader->rows_read() << " row(s) written to " << opt.out << "\n";
+  }
+}
+
+}  // namespace
+
+void register_dynamics(CLI::App& app) {
+  auto opt = std::make_shared<DynamicsOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "dynamics",
+      "Joint torques (inverse dynamics) and the predicted base force/torque sensor reading for each "
+      "row of a CSV of states");
+  sub->add_option("--robot", opt->robot, "Robot file: URDF (.urdf, .xml) or DH table (.yaml, .yml)")
+      ->required()
+      ->type_name("FILE");
+  sub->add_option("--in", opt->in,
+                  "CSV with a header row and columns t, q1..qn, dq1..dqn, ddq1..ddqn [s, rad or m, "
+                  "/s, /s^2], any order; other columns are ignored; '-' reads stdin")
+      ->required()
+      ->type_name("STATES.csv");
+  sub->add_option("--out", opt->out,
+                  "CSV written with t, tau1..taun [N m or N], fs_x fs_y fs_z [N], ms_x ms_y ms_z [N m]; "
+                  "'-' writes to stdout")
+      ->required()
+      ->type_name("OUT.csv");
+  sub->add_option("--sensor-pose", opt->sensor_pose,
+                  "Pose of the base sensor in the root frame, \"x y z roll pitch yaw\" (m, rad, URDF "
+                  "rpy). Default: the model's frame 'sensor', else the root link's origin, aligned")
+      ->type_name("\"X Y Z R P Y\"");
+  add_package_path_option(*sub, opt->package_path);
+  sub->footer(
+      "\nThe reading is what the robot discharges onto the sensor: force and moment about the sensor\n"
+      "origin, in the sensor frame (link 0's weight included). Numbers are written in the shortest\n"
+      "form that reads back to the same double.\n\n"
+      "Example:\n"
+      "  extwrench dynamics --robot models/paper_arm.yaml --in states.csv --out predicted.csv");
+  sub->callback([opt] { run_dynamics(*opt); });
+}
+
+}  // namespace extwrench::cli

@@ -1,0 +1,69 @@
+// extwrench: the command-line tool. Subcommands live one per file (commands.hpp).
+#include <exception>
+#include <iostream>
+
+#include "commands.hpp"
+#include "extwrench/core/error.hpp"
+
+#ifndef EXTWRENCH_VERSION
+#define EXTWRENCH_VERSION "unknown"
+#endif
+
+namespace {
+
+constexpr int kExitInputError = 1;
+constexpr int kExitUsageError = 2;
+
+constexpr const char* kFooter = R"(
+Examples:
+  extwrench info models/paper_arm.urdf
+      what the model contains: links, joints, masses, frames, sensor pose, collision shapes
+  extwrench dynamics --robot models/paper_arm.yaml --in states.csv --out predicted.csv
+      joint torques and the base sensor reading for each row t, q1..qn, dq1..dqn, ddq1..ddqn
+  extwrench dynamics --robot arm.urdf --sensor-pose "0 0 -0.05 0 0 3.1416" --in states.csv --out -
+      the same with the sensor 5 cm below the root link, turned by 180 deg; CSV to stdout
+  extwrench COMMAND --help
+      all options of one command
+
+Units are SI and radians throughout. Exit status: 0 success, 1 bad input file, 2 bad command line.
+Documentation: docs/cli.md (commands, CSV formats), README.md.)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "extwrench: external wrench and contact estimation for robot arms, from joint torques, a\n"
+      "momentum observer and an optional base force/torque sensor (Buondonno & De Luca, 2016).",
+      "extwrench"};
+  app.set_version_flag("--version", std::string("extwrench ") + EXTWRENCH_VERSION,
+                       "Print the version and exit");
+  app.require_subcommand(1);
+  app.footer(kFooter);
+
+  // One line per subcommand; each lives in its own file.
+  extwrench::cli::register_info(app);
+  extwrench::cli::register_dynamics(app);
+
+  if (argc <= 1) {  // a newcomer typing just `extwrench` gets the help, not an error
+    std::cout << app.help();
+    return kExitUsageError;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::Success& e) {  // --help, --version
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);
+    return kExitUsageError;
+  } catch (const extwrench::cli::UsageError& e) {
+    std::cerr << "extwrench: usage error: " << e.what() << "\nRun with --help for more information.\n";
+    return kExitUsageError;
+  } catch (const extwrench::Error& e) {
+    std::cerr << "extwrench: error: " << e.what() << "\n";
+    return kExitInputError;
+  } catch (const std::exception& e) {
+    std::cerr << "extwrench: error: " << e.what() << "\n";
+    return kExitInputError;
+  }
+  return 0;
+}

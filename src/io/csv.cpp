@@ -1,0 +1,395 @@
+#include "extwrench/io/csv.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <istream>
+#include <limits>
+#include <ostream>
+#include <system_error>
+
+#include "extwrench/core/error.hpp"
+
+namespace extwrench {
+namespace {
+
+constexpr std::size_t kReadChunk = std::size_t{1} << 18;   // 256 KiB per read()
+constexpr std::size_t kWriteChunk = std::size_t{1} << 20;  // flush the writer every 1 MiB
+constexpr std::size_t kShownCellChars = 40;                // longer cells are cut in messages
+
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::string shown(std::string_view cell) {
+  if (cell.size() <= kShownCellChars) return std::string(cell);
+  return std::string(cell.substr(0, kShownCellChars)) + "...";
+}
+
+enum class ParseResult { kOk, kNotANumber, kOutOfRange };
+
+ParseResult parse_strict(std::string_view s, double& value) {
+  if (s.empty()) return ParseResult::kNotANumber;
+  const char* p = s.data();
+  const char* const end = s.data() + s.size();
+  if (*p == '+') {  // from_chars rejects a leading '+', which other tools write
+    ++p;
+    if (p != end && (*p == '+' || *p == '-')) return ParseResult::kNotANumber;
+  }
+  const auto [ptr, ec] = std::from_chars(p, end, value);
+  if (ec == std::errc::result_out_of_range) return ParseResult::kOutOfRange;
+  if (ec != std::errc() || ptr != end) return ParseResult::kNotANumber;
+  return ParseResult::kOk;
+}
+
+}  // namespace
+
+std::optional<double> parse_number(std::string_view text) {
+  double value = 0.0;
+  if (parse_strict(text, value) != ParseResult::kOk || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+// ------------------------------------------------------------------------------------------
+// CsvReader
+
+CsvReader::CsvReader(const std::filesystem::path& path)
+    : owned_stream_(std::make_unique<std::ifstream>(path, std::ios::binary)), name_(path.string()) {
+  if (!*owned_stream_) throw Error(name_ + ": cannot open the file for reading");
+  in_ = owned_stream_.get();
+  read_header();
+}
+
+CsvReader::CsvReader(std::istream& in, std::string name) : in_(&in), name_(std::move(name)) {
+  read_header();
+}
+
+CsvReader::~CsvReader() = default;
+CsvReader::CsvReader(CsvReader&&) noexcept = default;
+CsvReader& CsvReader::operator=(CsvReader&&) noexcept = default;
+
+bool CsvReader::read_line() {
+  line_.clear();
+  bool got_any = false;
+  for (;;) {
+    if (buffer_pos_ == buffer_end_) {
+      if (eof_) break;
+      if (buffer_.size() < kReadChunk) buffer_.resize(kReadChunk);
+      in_->read(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+      buffer_end_ = static_cast<std::size_t>(in_->gcount());
+      buffer_pos_ = 0;
+      if (buffer_end_ < buffer_.size()) {
+        if (in_->bad()) throw Error(name_ + ":" + std::to_string(next_line_) + ": read error");
+        eof_ = true;
+      }
+      if (buffer_end_ == 0) break;
+    }
+    got_any = true;
+    const char* begin = buffer_.data() + buffer_pos_;
+    const std::size_t available = buffer_end_ - buffer_pos_;
+    const void* newline = std::memchr(begin, '\n', available);
+    if (newline != nullptr) {
+      const auto length = static_cast<std::size_t>(static_cast<const char*>(newline) - begin);
+      line_.append(begin, length);
+      buffer_pos_ += length + 1;
+      break;
+    }
+    line_.append(begin, available);
+    buffer_pos_ = buffer_end_;
+  }
+  if (!got_any) return false;
+  if (!line_.empty() && line_.back() == '\r') line_.pop_back();  // CRLF
+  row_line_ = next_line_++;
+  return true;
+}
+
+void CsvReader::split_line() {
+  cells_.clear();
+  const std::string_view line(line_);
+  if (line.find('"') == std::string_view::npos) {
+    // Fast path: no quotes at all.
+    std::size_t start = 0;
+    for (;;) {
+      const std::size_t comma = line.find(',', start);
+      if (comma == std::string_view::npos) {
+        cells_.push_back(trim(line.substr(start)));
+        break;
+      }
+      cells_.push_back(trim(line.substr(start, comma - start)));
+      start = comma + 1;
+    }
+    return;
+  }
+  // Quoted cells: unescaped text goes to unquoted_, reserved so the views stay valid.
+  unquoted_.clear();
+  unquoted_.reserve(line.size());
+  std::size_t i = 0;
+  for (;;) {
+    while (i < line.size() && is_blank(line[i])) ++i;
+    if (i < line.size() && line[i] == '"') {
+      const std::size_t first_column = cells_.size() + 1;
+      const std::size_t start = unquoted_.size();
+      ++i;
+      bool closed = false;
+      while (i < line.size()) {
+        if (line[i] == '"') {
+          if (i + 1 < line.size() && line[i + 1] == '"') {
+            unquoted_.push_back('"');
+            i += 2;
+            continue;
+          }
+          closed = true;
+          ++i;
+          break;
+        }
+        unquoted_.push_back(line[i++]);
+      }
+      if (!closed) {
+        throw Error(where() + "column " + std::to_string(first_column) +
+                    ": unterminated quoted cell (a quoted cell cannot span lines)");
+      }
+      cells_.emplace_back(unquoted_.data() + start, unquoted_.size() - start);
+      while (i < line.size() && is_blank(line[i])) ++i;
+      if (i < line.size() && line[i] != ',') {
+        throw Error(where() + "column " + std::to_string(first_column) +
+                    ": unexpected text after a closing quote");
+      }
+    } else {
+      const std::size_t comma = std::min(line.find(',', i), line.size());
+      const std::string_view cell = trim(line.substr(i, comma - i));
+      if (cell.find('"') != std::string_view::npos) {
+        throw Error(where() + "column " + std::to_string(cells_.size() + 1) +
+                    ": a quote inside an unquoted cell (quote the whole cell and double the quote)");
+      }
+      cells_.push_back(cell);
+      i = comma;
+    }
+    if (i >= line.size()) break;
+    ++i;  // the comma
+  }
+}
+
+void CsvReader::read_header() {
+  for (;;) {
+    if (!read_line()) throw Error(name_ + ": empty file: expected a header row of column names");
+    if (row_line_ == 1 && line_.rfind("\xEF\xBB\xBF", 0) == 0) line_.erase(0, 3);  // UTF-8 BOM
+    if (!trim(line_).empty()) break;
+  }
+  split_line();
+  header_.assign(cells_.begin(), cells_.end());
+  for (std::size_t k = 0; k < header_.size(); ++k) {
+    if (header_[k].empty()) {
+      throw Error(where() + "column " + std::to_string(k + 1) + " of the header has an empty name");
+    }
+    for (std::size_t j = 0; j < k; ++j) {
+      if (header_[j] == header_[k]) {
+        throw Error(where() + "column " + std::to_string(k + 1) + " '" + header_[k] +
+                    "' appears twice in the header (also column " + std::to_string(j + 1) + ")");
+      }
+    }
+  }
+  cells_.clear();
+}
+
+std::optional<int> CsvReader::find_column(std::string_view column_name) const {
+  const auto it = std::find(header_.begin(), header_.end(), column_name);
+  if (it == header_.end()) return std::nullopt;
+  return static_cast<int>(it - header_.begin());
+}
+
+int CsvReader::column(std::string_view column_name) const {
+  if (const auto c = find_column(column_name)) return *c;
+  throw Error(name_ + ":1: missing column '" + std::string(column_name) + "'");
+}
+
+bool CsvReader::next_row() {
+  for (;;) {
+    if (!read_line()) {
+      cells_.clear();
+      return false;
+    }
+    if (!trim(line_).empty()) break;  // blank lines are skipped
+  }
+  split_line();
+  if (cells_.size() != header_.size()) {
+    throw Error(where() + "expected " + std::to_string(header_.size()) +
+                " cells as in the header, got " + std::to_string(cells_.size()));
+  }
+  ++rows_read_;
+  return true;
+}
+
+std::string_view CsvReader::cell(int column) const {
+  if (column < 0 || static_cast<std::size_t>(column) >= cells_.size()) {
+    throw Error(where() + "no cell " + std::to_string(column + 1) + " in this row");
+  }
+  return cells_[static_cast<std::size_t>(column)];
+}
+
+std::string CsvReader::where() const { return name_ + ":" + std::to_string(row_line_) + ": "; }
+
+std::string CsvReader::where(int column) const {
+  std::string s = where() + "column " + std::to_string(column + 1);
+  if (column >= 0 && static_cast<std::size_t>(column) < header_.size()) {
+    s += " '" + header_[static_cast<std::size_t>(column)] + "'";
+  }
+  return s + ": ";
+}
+
+void CsvReader::fail_number(int column, std::string_view reason) const {
+  throw Error(where(column) + std::string(reason));
+}
+
+double CsvReader::parse(int column, bool allow_missing) const {
+  const std::string_view s = cell(column);
+  if (s.empty()) {
+    if (allow_missing) return std::numeric_limits<double>::quiet_NaN();
+    fail_number(column, "empty cell, expected a number");
+  }
+  double value = 0.0;
+  const ParseResult result = parse_strict(s, value);
+  if (result == ParseResult::kOutOfRange) {
+    fail_number(column, "number out of the range of a double: '" + shown(s) + "'");
+  }
+  if (result != ParseResult::kOk) fail_number(column, "expected a number, got '" + shown(s) + "'");
+  if (std::isnan(value)) {
+    if (allow_missing) return std::numeric_limits<double>::quiet_NaN();
+    fail_number(column, "expected a finite number, got '" + shown(s) + "'");
+  }
+  if (std::isinf(value) && !allow_missing) {
+    fail_number(column, "expected a finite number, got '" + shown(s) + "'");
+  }
+  return value;
+}
+
+double CsvReader::number(int column) const { return parse(column, false); }
+double CsvReader::number_or_nan(int column) const { return parse(column, true); }
+
+// ------------------------------------------------------------------------------------------
+// CsvWriter
+
+CsvWriter::CsvWriter(const std::filesystem::path& path, std::vector<std::string> header)
+    : owned_stream_(std::make_unique<std::ofstream>(path, std::ios::binary | std::ios::trunc)),
+      name_(path.string()),
+      header_(std::move(header)) {
+  if (!*owned_stream_) throw Error(name_ + ": cannot create the file");
+  out_ = owned_stream_.get();
+  if (header_.empty()) throw Error(name_ + ": a CSV file needs at least one column");
+  for (const auto& h : header_) add(std::string_view(h));
+  end_row();
+}
+
+CsvWriter::CsvWriter(std::ostream& out, std::vector<std::string> header, std::string name)
+    : out_(&out), name_(std::move(name)), header_(std::move(header)) {
+  if (header_.empty()) throw Error(name_ + ": a CSV file needs at least one column");
+  for (const auto& h : header_) add(std::string_view(h));
+  end_row();
+}
+
+CsvWriter::~CsvWriter() {
+  try {
+    flush();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): a destructor must not throw; close() reports
+  }
+}
+
+void CsvWriter::append(std::string& out, double value) {
+  std::array<char, 32> text{};  // the shortest form of a double has at most 24 characters
+  const auto [ptr, ec] = std::to_chars(text.data(), text.data() + text.size(), value);
+  (void)ec;  // cannot fail with 32 characters
+  out.append(text.data(), ptr);
+}
+
+std::string CsvWriter::format(double value) {
+  std::string s;
+  append(s, value);
+  return s;
+}
+
+void CsvWriter::separator() {
+  if (cells_in_row_ > 0) buffer_.push_back(',');
+  ++cells_in_row_;
+}
+
+CsvWriter& CsvWriter::add(double value) {
+  separator();
+  if (!std::isnan(value)) append(buffer_, value);
+  return *this;
+}
+
+CsvWriter& CsvWriter::add(long long value) {
+  separator();
+  std::array<char, 24> text{};
+  const auto [ptr, ec] = std::to_chars(text.data(), text.data() + text.size(), value);
+  (void)ec;
+  buffer_.append(text.data(), ptr);
+  return *this;
+}
+
+CsvWriter& CsvWriter::add(int value) { return add(static_cast<long long>(value)); }
+CsvWriter& CsvWriter::add(std::size_t value) { return add(static_cast<long long>(value)); }
+
+CsvWriter& CsvWriter::add(std::string_view text) {
+  separator();
+  const bool needs_quotes =
+      text.find_first_of(",\"\r\n") != std::string_view::npos ||
+      (!text.empty() && (is_blank(text.front()) || is_blank(text.back())));
+  if (!needs_quotes) {
+    buffer_.append(text);
+    return *this;
+  }
+  buffer_.push_back('"');
+  for (const char c : text) {
+    if (c == '"') buffer_.push_back('"');
+    buffer_.push_back(c);
+  }
+  buffer_.push_back('"');
+  return *this;
+}
+
+CsvWriter& CsvWriter::add_empty() {
+  separator();
+  return *this;
+}
+
+void CsvWriter::end_row() {
+  if (cells_in_row_ != header_.size()) {
+    const std::size_t got = cells_in_row_;
+    buffer_.resize(row_start_);  // drop the incomplete row
+    cells_in_row_ = 0;
+    throw Error(name_ + ": internal error: a row of " + std::to_string(got) + " cells for " +
+                std::to_string(header_.size()) + " columns");
+  }
+  buffer_.push_back('\n');
+  cells_in_row_ = 0;
+  if (buffer_.size() >= kWriteChunk) flush();
+  row_start_ = buffer_.size();
+}
+
+void CsvWriter::flush() {
+  if (out_ == nullptr) return;
+  if (!buffer_.empty()) {
+    out_->write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    buffer_.clear();
+    row_start_ = 0;
+  }
+  out_->flush();
+  if (!*out_) throw Error(name_ + ": write failed (disk full or file removed?)");
+}
+
+void CsvWriter::close() {
+  flush();
+  if (owned_stream_) {
+    owned_stream_->close();
+    if (!*owned_stream_) throw Error(name_ + ": closing the file failed");
+  }
+  out_ = nullptr;
+}
+
+}  // namespace extwrench
