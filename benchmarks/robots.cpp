@@ -11,6 +11,7 @@
 #include <kdl_parser/kdl_parser.hpp>
 
 #include "extwrench/dynamics/data.hpp"
+#include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/robot_loader.hpp"
 
@@ -210,7 +211,55 @@ StatePool make_state_pool(int n) {
   return pool;
 }
 
+Trajectory make_trajectory(const Model& model) {
+  Trajectory tr;
+  const int n = model.nq();
+  // Away from the wrist/elbow singularities (q2, q4 far from 0), so case E stays well posed.
+  const double q0[7] = {0.3, 0.8, 0.2, -1.2, 0.4, 0.9, 0.1};
+  const double amp[7] = {0.4, 0.25, 0.5, 0.25, 0.6, 0.3, 0.8};
+  const double freq[7] = {0.5, 1.0, 0.5, 1.0, 1.0, 0.5, 1.0};  // [Hz]: period 2 s = 2000 samples
+  const double phase[7] = {0.0, 0.7, 1.4, 2.1, 2.8, 3.5, 4.2};
+  if (n != 7) throw std::runtime_error("the benchmark trajectory expects the 7-DoF paper arm");
+  Data data(model);
+  const auto sensor = model.find_frame("sensor");
+  for (std::size_t k = 0; k < Trajectory::kNumSamples; ++k) {
+    const double t = static_cast<double>(k) * tr.dt;
+    VectorX q(n), dq(n), ddq(n);
+    for (int i = 0; i < n; ++i) {
+      const double w = 2.0 * kPi * freq[i];
+      const double arg = w * t + phase[i];
+      q[i] = q0[i] + amp[i] * std::sin(arg);
+      dq[i] = amp[i] * w * std::cos(arg);
+      ddq[i] = -amp[i] * w * w * std::sin(arg);
+    }
+    forward_kinematics(model, data, q);
+    if (k == 0) tr.X_WS = sensor ? frame_pose(model, data, *sensor) : Pose::identity();
+    const Pose& X_WB = data.X_WB[static_cast<std::size_t>(tr.contact_body)];
+    const ExternalWrench contact{tr.contact_body, X_WB.rotation * tr.contact_force_B,
+                                 X_WB.act(tr.contact_point_B), Vector3::Zero()};
+    rnea_no_kinematics(model, data, dq, ddq, std::span<const ExternalWrench>(&contact, 1));
+    tr.q.push_back(q);
+    tr.dq.push_back(dq);
+    tr.ddq.push_back(ddq);
+    tr.tau.push_back(data.tau);
+    tr.ft_S.push_back(sensor_reading(data, tr.X_WS));
+    KDL::JntArray a(static_cast<unsigned>(n));
+    a.data = q;
+    tr.kq.push_back(a);
+    a.data = dq;
+    tr.kdq.push_back(a);
+    a.data = data.tau;
+    tr.ktau.push_back(a);
+  }
+  return tr;
+}
+
 }  // namespace
+
+const Trajectory& trajectory() {
+  static const Trajectory tr = make_trajectory(paper_arm().model);
+  return tr;
+}
 
 const PaperArm& paper_arm() {
   static const PaperArm arm = [] {

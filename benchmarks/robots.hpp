@@ -37,6 +37,24 @@ struct StatePool {
 };
 const StatePool& state_pool();
 
+/// A periodic, smooth joint trajectory sampled at 1 kHz, with a constant pure force on link 6
+/// (fixed in link 6's frame, applied at a point of its capsule's surface, pushing): the commanded
+/// torques τ = RNEA(q, q̇, q̈) − J_pᵀ F make the robot follow it exactly, and the base F/T sensor
+/// reads the robot's discharge plus the contact force. The estimator benchmarks replay it with
+/// t_k = k·dt; its period is a whole number of samples, so wrapping around stays smooth.
+struct Trajectory {
+  static constexpr std::size_t kNumSamples = 2000;  ///< 2 s: the frequencies are 0.5 and 1 Hz
+  double dt = 1e-3;
+  int contact_body = 6;
+  Vector3 contact_point_B{0.065, 0.0, 0.01};  ///< on link 6's capsule (r = 0.065 m), body frame
+  Vector3 contact_force_B{-20.0, 4.0, 2.0};    ///< [N], body frame, into the surface
+  Pose X_WS;                                   ///< base sensor frame "sensor"
+  std::vector<VectorX> q, dq, ddq, tau;
+  std::vector<Vector6> ft_S;                   ///< base F/T reading [f_m; n_m] in the sensor frame
+  std::vector<KDL::JntArray> kq, kdq, ktau;
+};
+const Trajectory& trajectory();
+
 /// Allocations per call of `f`, over `calls` calls after one warm-up call.
 template <class F>
 double allocations_per_call(F&& f, int calls = 1000) {
