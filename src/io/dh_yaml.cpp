@@ -71,11 +71,11 @@ class DhParser {
   DhParser(std::string file, fs::path base_dir) : file_(std::move(file)), base_dir_(std::move(base_dir)) {}
 
   RobotDescription parse(const YAML::Node& root, const LoadOptions& options) {
-    expect_map(root, "document", root);
-    check_keys(root, "document", {"name", "convention", "gravity", "base", "joints", "frames"});
+    expect_map(root, "(document)", root);
+    check_keys(root, "", {"name", "convention", "gravity", "base", "joints", "frames"});
     ModelBuilder builder;
     builder.set_name(root["name"] ? scalar(root["name"], "name") : fs::path(file_).stem().string());
-    if (!root["convention"]) fail(root, "document", "key 'convention': missing (required: standard or modified)");
+    if (!root["convention"]) fail(root, "convention", "missing (required: standard or modified)");
     const std::string convention = scalar(root["convention"], "convention");
     bool modified = false;
     if (convention == "modified") {
@@ -83,11 +83,11 @@ class DhParser {
     } else if (convention != "standard") {
       fail(root["convention"], "convention", "expected 'standard' or 'modified', got '" + convention + "'");
     }
-    if (root["gravity"]) builder.set_gravity(vec3(root, "gravity", "document", std::nullopt));
+    if (root["gravity"]) builder.set_gravity(vec3(root, "gravity", "", std::nullopt));
     if (options.gravity) builder.set_gravity(*options.gravity);
 
     // Link 0.
-    if (!root["base"]) fail(root, "document", "key 'base': missing (required: link 0)");
+    if (!root["base"]) fail(root, "base", "missing (required: link 0)");
     const YAML::Node base = root["base"];
     expect_map(base, "base", base);
     check_keys(base, "base", {"name", "mass", "com", "inertia", "collision"});
@@ -96,7 +96,7 @@ class DhParser {
     parse_collisions(base, "base", parent, Pose::identity());
     dh_placement_[parent] = Pose::identity();
 
-    if (!root["joints"]) fail(root, "document", "key 'joints': missing (required)");
+    if (!root["joints"]) fail(root, "joints", "missing (required)");
     const YAML::Node joints = root["joints"];
     if (!joints.IsSequence() || joints.size() == 0) fail(joints, "joints", "expected a non-empty list of joints");
     // P = X_{body, DH frame} of the previous link: identity unless it is a standard-DH link with a != 0.
@@ -151,7 +151,7 @@ class DhParser {
       }
       js.parent = parent;
 
-      if (!j["link"]) fail(j, path, "key 'link': missing (required)");
+      if (!j["link"]) fail(j, path + ".link", "missing (required)");
       const YAML::Node link = j["link"];
       const std::string lpath = path + ".link";
       expect_map(link, lpath, link);
@@ -207,6 +207,9 @@ class DhParser {
     const auto m = n.Mark();
     return file_ + ":" + std::to_string(m.is_null() ? 0 : m.line + 1);
   }
+  static std::string join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
   [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& what) const {
     throw Error(at(n) + ": key '" + key + "': " + what);
   }
@@ -220,7 +223,7 @@ class DhParser {
       if (!ok.count(k)) {
         std::string list;
         for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        fail(kv.first, path + "." + k, "unknown key (allowed: " + list + ")");
+        fail(kv.first, join(path, k), "unknown key (allowed: " + list + ")");
       }
     }
   }
@@ -229,9 +232,9 @@ class DhParser {
     return n.Scalar();
   }
   std::string required_scalar(const YAML::Node& map, const char* key, const std::string& path) const {
-    if (!map[key]) fail(map, path + "." + key, "missing (required)");
-    const std::string s = scalar(map[key], path + "." + key);
-    if (s.empty()) fail(map[key], path + "." + key, "must not be empty");
+    if (!map[key]) fail(map, join(path, key), "missing (required)");
+    const std::string s = scalar(map[key], join(path, key));
+    if (s.empty()) fail(map[key], join(path, key), "must not be empty");
     return s;
   }
   double to_number(const YAML::Node& n, const std::string& path, bool angle) const {
@@ -245,14 +248,14 @@ class DhParser {
     const YAML::Node n = map[key];
     if (!n) {
       if (fallback) return *fallback;
-      fail(map, path + "." + key, "missing (required)");
+      fail(map, join(path, key), "missing (required)");
     }
-    return to_number(n, path + "." + key, angle);
+    return to_number(n, join(path, key), angle);
   }
   Vector3 vec3(const YAML::Node& map, const char* key, const std::string& path, std::optional<Vector3> fallback,
                bool angle = false) const {
     const YAML::Node n = map[key];
-    const std::string p = path + "." + key;
+    const std::string p = join(path, key);
     if (!n) {
       if (fallback) return *fallback;
       fail(map, p, "missing (required)");
@@ -294,6 +297,7 @@ class DhParser {
     l.source = at(map);
     Inertia in;
     in.mass = number(map, "mass", path, std::nullopt, false);
+    if (in.mass < 0.0) fail(map["mass"], join(path, "mass"), "must not be negative, got '" + map["mass"].Scalar() + "'");
     in.com = vec3(map, "com", path, Vector3::Zero());
     if (map["inertia"]) {
       in.inertia_com = inertia(map["inertia"], path + ".inertia");

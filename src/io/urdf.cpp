@@ -123,6 +123,7 @@ class UrdfParser {
       const XMLElement* inertia = required_child(inertial, "inertia", owner);
       Inertia in;
       in.mass = number(mass, "value", owner, std::nullopt);
+      if (in.mass < 0.0) fail(mass, owner, std::string("attribute 'value': must not be negative, got '") + mass->Attribute("value") + "'");
       const double ixx = number(inertia, "ixx", owner, std::nullopt);
       const double ixy = number(inertia, "ixy", owner, std::nullopt);
       const double ixz = number(inertia, "ixz", owner, std::nullopt);
