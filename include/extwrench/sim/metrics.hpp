@@ -1,0 +1,102 @@
+// Accuracy metrics of an estimator against the truth (SPEC 6), accumulated sample by sample in
+// constant memory, over a stated time window.
+#pragma once
+
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "extwrench/core/types.hpp"
+
+namespace extwrench::sim {
+
+/// Time window of a metric: [from, to] minus the excluded intervals.
+struct MetricsWindow {
+  double from = 0.0;
+  double to = std::numeric_limits<double>::infinity();
+  std::vector<std::pair<double, double>> exclude;
+  [[nodiscard]] bool contains(double t) const noexcept;
+};
+
+/// What the estimator said at a sample (world frame). Flags say which quantities it produced.
+struct EstimateSample {
+  bool contact = false;
+  int body = -1;
+  bool has_force = false;
+  Vector3 force = Vector3::Zero();
+  bool has_moment = false;
+  Vector3 moment = Vector3::Zero();
+  bool has_line = false;
+  Vector3 line_point = Vector3::Zero();      ///< p̂ of eq. (20)
+  Vector3 line_direction = Vector3::Zero();  ///< unit F̂ / ‖F̂‖
+  bool has_surface_point = false;
+  Vector3 surface_point = Vector3::Zero();
+};
+
+/// The truth at a sample (world frame).
+struct TruthSample {
+  bool contact = false;
+  int body = -1;
+  int contacts = 0;
+  Vector3 force = Vector3::Zero();
+  Vector3 moment = Vector3::Zero();
+  Vector3 point = Vector3::Zero();
+};
+
+/// RMS and max of an error over the samples where it was evaluated.
+struct ErrorStat {
+  long count = 0;
+  double sum_sq = 0.0;
+  double max = 0.0;
+  void add(double e) noexcept;
+  [[nodiscard]] double rms() const noexcept;
+};
+
+struct Metrics {
+  MetricsWindow window;
+  long samples = 0;            ///< samples in the window
+  long contact_samples = 0;    ///< in contact (single contact) in the window
+  long free_samples = 0;
+  /// ‖F̂ − F‖ over every sample of the window where the estimator gave a force (F̂ = 0 when it
+  /// reports no contact, F = 0 when free).
+  ErrorStat force;
+  /// ‖M̂ − M‖, same rule with the moment.
+  ErrorStat moment;
+  /// Distance from the true point to the estimated line of action (in-contact samples with a line).
+  ErrorStat line;
+  /// ‖p_c − p‖, in-contact samples with a surface point (meaningful when p lies on the surface).
+  ErrorStat surface;
+  long force_not_estimated = 0;   ///< contact reported but no force estimated
+  long line_not_estimated = 0;    ///< in contact, no line of action
+  long right_link = 0;            ///< in contact, detected on the right link
+  long missed = 0;                ///< in contact, not detected
+  long false_alarms = 0;          ///< free, contact reported
+  // Detection delay: over the whole log (not windowed), from each onset of contact.
+  long onsets = 0;
+  long onsets_detected = 0;
+  double delay_sum = 0.0;
+  double delay_max = 0.0;
+
+  [[nodiscard]] double isolation_accuracy() const noexcept;   ///< right_link / contact_samples
+  [[nodiscard]] double false_alarm_rate() const noexcept;     ///< false_alarms / free_samples
+  [[nodiscard]] double mean_detection_delay() const noexcept;
+};
+
+/// Feeds samples in time order; result() can be read at any point.
+class MetricsAccumulator {
+ public:
+  explicit MetricsAccumulator(MetricsWindow window);
+  void add(double t, const TruthSample& truth, const EstimateSample& estimate) noexcept;
+  [[nodiscard]] Metrics result() const;
+
+ private:
+  Metrics m_;
+  bool in_contact_ = false;
+  bool waiting_detection_ = false;
+  double onset_t_ = 0.0;
+};
+
+/// Distance from point p to the line through a with unit direction u.
+[[nodiscard]] double point_line_distance(const Vector3& p, const Vector3& a, const Vector3& u) noexcept;
+
+}  // namespace extwrench::sim

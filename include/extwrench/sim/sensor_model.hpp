@@ -1,0 +1,53 @@
+// Models of the robot's measurements: base force/torque sensor, joint encoders, velocities.
+#pragma once
+
+#include <cstdint>
+
+#include "extwrench/core/types.hpp"
+#include "extwrench/sim/random.hpp"
+
+namespace extwrench::sim {
+
+enum class BaseSensorType { kNone, kForce, kForceTorque };
+
+/// The base sensor (SPEC 3): what the robot discharges onto it, in its own frame, moment about
+/// its origin, plus a constant bias and white Gaussian noise per axis.
+struct BaseSensorModel {
+  BaseSensorType type = BaseSensorType::kForceTorque;
+  Pose X_RS;                         ///< pose of the sensor frame in the robot's root frame
+  Vector6 bias = Vector6::Zero();    ///< [N; N m] added to every reading
+  Vector3 force_noise = Vector3::Zero();   ///< standard deviation per axis [N]
+  Vector3 moment_noise = Vector3::Zero();  ///< standard deviation per axis [N m]
+
+  /// Ideal reading + bias + noise. Noise is drawn for all six axes every call (whatever the
+  /// type), so the stream does not depend on the sensor type.
+  [[nodiscard]] Vector6 measure(const Vector6& ideal, Rng& rng) const noexcept;
+};
+
+/// Joint encoders and the velocity the robot reports.
+struct EncoderModel {
+  double resolution = 0.0;       ///< quantization step [rad | m]; 0: exact positions
+  bool differentiate = false;    ///< q̇ by backward difference of the measured q (else exact)
+  double velocity_cutoff = 0.0;  ///< first-order low-pass on the difference [Hz]; 0: none
+
+  /// Quantized position: resolution · round(q / resolution).
+  [[nodiscard]] double quantize(double q) const noexcept;
+};
+
+/// Measured joint state from the true one, sample after sample.
+class JointSensor {
+ public:
+  JointSensor(EncoderModel model, int n);
+  /// True q, q̇ at time t → measured q, q̇ (written into q_out, dq_out, size n). The first
+  /// call, and every call when the velocity is not differentiated, reports q̇ exactly.
+  void measure(double t, const VectorX& q, const VectorX& dq, VectorX& q_out,
+               VectorX& dq_out) noexcept;
+
+ private:
+  EncoderModel model_;
+  VectorX last_q_, last_dq_;
+  double last_t_ = 0.0;
+  bool first_ = true;
+};
+
+}  // namespace extwrench::sim

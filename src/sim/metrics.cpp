@@ -1,0 +1,102 @@
+#include "extwrench/sim/metrics.hpp"
+
+#include <cmath>
+
+namespace extwrench::sim {
+
+bool MetricsWindow::contains(double t) const noexcept {
+  if (t < from || t > to) return false;
+  for (const auto& [a, b] : exclude) {
+    if (t >= a && t <= b) return false;
+  }
+  return true;
+}
+
+void ErrorStat::add(double e) noexcept {
+  ++count;
+  sum_sq += e * e;
+  if (e > max) max = e;
+}
+
+double ErrorStat::rms() const noexcept {
+  return count > 0 ? std::sqrt(sum_sq / static_cast<double>(count)) : std::nan("");
+}
+
+double Metrics::isolation_accuracy() const noexcept {
+  return contact_samples > 0 ? static_cast<double>(right_link) / static_cast<double>(contact_samples)
+                             : std::nan("");
+}
+double Metrics::false_alarm_rate() const noexcept {
+  return free_samples > 0 ? static_cast<double>(false_alarms) / static_cast<double>(free_samples)
+                          : std::nan("");
+}
+double Metrics::mean_detection_delay() const noexcept {
+  return onsets_detected > 0 ? delay_sum / static_cast<double>(onsets_detected) : std::nan("");
+}
+
+double point_line_distance(const Vector3& p, const Vector3& a, const Vector3& u) noexcept {
+  const Vector3 d = p - a;
+  return (d - d.dot(u) * u).norm();
+}
+
+MetricsAccumulator::MetricsAccumulator(MetricsWindow window) { m_.window = std::move(window); }
+
+void MetricsAccumulator::add(double t, const TruthSample& truth,
+                             const EstimateSample& est) noexcept {
+  // Detection delay, over the whole log: onset = first sample of a contact.
+  if (truth.contact && !in_contact_) {
+    ++m_.onsets;
+    onset_t_ = t;
+    waiting_detection_ = true;
+  }
+  in_contact_ = truth.contact;
+  if (!truth.contact) waiting_detection_ = false;
+  if (waiting_detection_ && est.contact) {
+    const double delay = t - onset_t_;
+    ++m_.onsets_detected;
+    m_.delay_sum += delay;
+    if (delay > m_.delay_max) m_.delay_max = delay;
+    waiting_detection_ = false;
+  }
+
+  if (!m_.window.contains(t)) return;
+  ++m_.samples;
+  // Force and moment errors: no detection means F̂ = 0, M̂ = 0; free means F = 0, M = 0.
+  const Vector3 f_true = truth.contact ? truth.force : Vector3::Zero();
+  const Vector3 m_true = truth.contact ? truth.moment : Vector3::Zero();
+  if (!est.contact) {
+    m_.force.add(f_true.norm());
+  } else if (est.has_force) {
+    m_.force.add((est.force - f_true).norm());
+  } else {
+    ++m_.force_not_estimated;
+  }
+  if (!est.contact) {
+    m_.moment.add(m_true.norm());
+  } else if (est.has_moment) {
+    m_.moment.add((est.moment - m_true).norm());
+  }
+
+  if (!truth.contact) {
+    ++m_.free_samples;
+    if (est.contact) ++m_.false_alarms;
+    return;
+  }
+  if (truth.contacts > 1) return;  // several contacts: link, line and point are not single-valued
+  ++m_.contact_samples;
+  if (!est.contact) {
+    ++m_.missed;
+  } else if (est.body == truth.body) {
+    ++m_.right_link;
+  }
+  if (est.contact && est.has_line) {
+    m_.line.add(point_line_distance(truth.point, est.line_point, est.line_direction));
+  } else {
+    ++m_.line_not_estimated;
+  }
+  if (est.contact && est.has_surface_point) m_.surface.add((est.surface_point - truth.point).norm());
+}
+
+Metrics MetricsAccumulator::result() const { return m_; }
+
+}  // namespace extwrench::sim

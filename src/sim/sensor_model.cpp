@@ -1,0 +1,44 @@
+#include "extwrench/sim/sensor_model.hpp"
+
+#include <cmath>
+#include <numbers>
+
+namespace extwrench::sim {
+
+Vector6 BaseSensorModel::measure(const Vector6& ideal, Rng& rng) const noexcept {
+  Vector6 out = ideal + bias;
+  for (int k = 0; k < 3; ++k) out[k] += force_noise[k] * rng.normal();
+  for (int k = 0; k < 3; ++k) out[3 + k] += moment_noise[k] * rng.normal();
+  return out;
+}
+
+double EncoderModel::quantize(double q) const noexcept {
+  if (resolution <= 0.0) return q;
+  return resolution * std::round(q / resolution);
+}
+
+JointSensor::JointSensor(EncoderModel model, int n)
+    : model_(model), last_q_(VectorX::Zero(n)), last_dq_(VectorX::Zero(n)) {}
+
+void JointSensor::measure(double t, const VectorX& q, const VectorX& dq, VectorX& q_out,
+                          VectorX& dq_out) noexcept {
+  for (Eigen::Index i = 0; i < q.size(); ++i) q_out[i] = model_.quantize(q[i]);
+  if (!model_.differentiate || first_) {
+    dq_out = dq;
+  } else {
+    const double dt = t - last_t_;
+    // Backward difference, then an optional first-order low-pass (exact discretization).
+    const double alpha =
+        model_.velocity_cutoff > 0.0 ? 1.0 - std::exp(-2.0 * std::numbers::pi * model_.velocity_cutoff * dt) : 1.0;
+    for (Eigen::Index i = 0; i < q.size(); ++i) {
+      const double raw = (q_out[i] - last_q_[i]) / dt;
+      dq_out[i] = last_dq_[i] + alpha * (raw - last_dq_[i]);
+    }
+  }
+  first_ = false;
+  last_t_ = t;
+  last_q_ = q_out;
+  last_dq_ = dq_out;
+}
+
+}  // namespace extwrench::sim

@@ -1,0 +1,401 @@
+// The closed-loop simulator checked against physics: energy balance, the RNEA path, RK4's order,
+// force profiles, sensor models, the perturbed model and the controller's tracking.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/dynamics/crba.hpp"
+#include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/sim/metrics.hpp"
+#include "extwrench/sim/perturb.hpp"
+#include "extwrench/sim/simulator.hpp"
+#include "support/random_model.hpp"
+
+namespace extwrench::sim {
+namespace {
+
+using test::RandomModelOptions;
+using test::SeededRng;
+
+// RK4 at 1e-3 s on these arms: local error ~ h^5 · (rate)^5 ~ 1e-12 per step.
+constexpr double kEnergyTol = 1e-6;
+// Algebraic identities that only reorder floating-point operations.
+constexpr double kAlgebraicTol = 1e-9;
+
+double kinetic_energy(const Model& model, Data& data, const VectorX& q, const VectorX& dq) {
+  crba(model, data, q);
+  return 0.5 * dq.dot(data.M * dq);
+}
+
+double potential_energy(const Model& model, Data& data, const VectorX& q) {
+  forward_kinematics(model, data, q);
+  double u = 0.0;
+  for (int i = 0; i < model.num_bodies(); ++i) u -= model.gravity.dot(data.first_moment_W[i]);
+  return u;
+}
+
+TEST(Rk4, ConservesTheEnergyOfAnUnactuatedArm) {
+  const Model model = test::random_model({.n = 7, .seed = 3});
+  Rk4Workspace ws(model);
+  Data data(model);
+  SeededRng rng(5);
+  VectorX q = rng.uniform_vector(7, -1, 1);
+  VectorX dq = rng.uniform_vector(7, -1, 1);
+  const VectorX tau = VectorX::Zero(7);
+  const double e0 = kinetic_energy(model, data, q, dq) + potential_energy(model, data, q);
+  for (int k = 0; k < 1000; ++k) ASSERT_TRUE(rk4_step(model, {}, k * 1e-3, 1e-3, tau, q, dq, ws));
+  const double e1 = kinetic_energy(model, data, q, dq) + potential_energy(model, data, q);
+  EXPECT_NEAR(e1, e0, kEnergyTol * std::max(1.0, std::abs(e0)));
+}
+
+TEST(Rk4, EnergyChangeEqualsTheWorkOfTorquesAndExternalForces) {
+  const Model model = test::random_model({.n = 5, .seed = 8});
+  std::vector<ForceProfile> forces(1);
+  forces[0].frame = "link4";
+  forces[0].axes = ForceProfile::Axes::kWorld;
+  forces[0].force = Vector3(3.0, -2.0, 5.0);
+  forces[0].moment = Vector3(0.2, 0.1, -0.3);
+  forces[0].point = Vector3(0.05, 0.0, 0.1);
+  forces[0].resolve(model);
+  Rk4Workspace ws(model);
+  Data data(model);
+  SeededRng rng(9);
+  VectorX q = rng.uniform_vector(5, -1, 1);
+  VectorX dq = rng.uniform_vector(5, -0.5, 0.5);
+  const VectorX tau = rng.uniform_vector(5, -2, 2);
+  const double h = 1e-4;
+  const double e0 = kinetic_energy(model, data, q, dq) + potential_energy(model, data, q);
+  // dE/dt = q̇ᵀ (τ + τ_ext): integrate the power with the trapezoidal rule (error O(h²)).
+  auto power = [&](double t, const VectorX& qq, const VectorX& vv) {
+    EXPECT_TRUE(true_acceleration(model, forces, t, qq, vv, tau, ws));
+    return vv.dot(tau + ws.tau_ext);
+  };
+  double work = 0.0;
+  double p_prev = power(0.0, q, dq);
+  for (int k = 0; k < 2000; ++k) {
+    ASSERT_TRUE(rk4_step(model, forces, k * h, h, tau, q, dq, ws));
+    const double p = power((k + 1) * h, q, dq);
+    work += 0.5 * h * (p_prev + p);
+    p_prev = p;
+  }
+  const double e1 = kinetic_energy(model, data, q, dq) + potential_energy(model, data, q);
+  EXPECT_NEAR(e1 - e0, work, 1e-5 * std::max(1.0, std::abs(work)));
+}
+
+TEST(Rk4, ErrorShrinksWithTheFourthPowerOfTheStep) {
+  const Model model = test::random_model({.n = 4, .seed = 2});
+  Rk4Workspace ws(model);
+  SeededRng rng(4);
+  const VectorX q0 = rng.uniform_vector(4, -1, 1);
+  const VectorX dq0 = rng.uniform_vector(4, -1, 1);
+  const VectorX tau = rng.uniform_vector(4, -1, 1);
+  auto run = [&](int steps) {
+    VectorX q = q0, dq = dq0;
+    const double h = 0.2 / steps;
+    for (int k = 0; k < steps; ++k) EXPECT_TRUE(rk4_step(model, {}, k * h, h, tau, q, dq, ws));
+    return q;
+  };
+  const VectorX reference = run(1280);
+  const double e1 = (run(10) - reference).norm();
+  const double e2 = (run(20) - reference).norm();
+  // Global error O(h^4): halving h divides it by 16 (a margin for the asymptotic regime).
+  EXPECT_GT(e1 / e2, 12.0);
+  EXPECT_LT(e1 / e2, 20.0);
+}
+
+TEST(Simulator, TrueAccelerationSatisfiesInverseDynamicsWithTheExternalWrench) {
+  const Model model = test::random_model({.n = 7, .seed = 12});
+  std::vector<ForceProfile> forces(2);
+  forces[0].frame = "link6";
+  forces[0].force = Vector3(20, 0, 0);
+  forces[0].point = Vector3(0, 0, 0.1);
+  forces[1].frame = "link3";
+  forces[1].axes = ForceProfile::Axes::kWorld;
+  forces[1].force = Vector3(0, -4, 1);
+  forces[1].moment = Vector3(0.5, 0, 0);
+  for (auto& f : forces) f.resolve(model);
+  Rk4Workspace ws(model);
+  Data data(model);
+  SeededRng rng(13);
+  for (int trial = 0; trial < 20; ++trial) {
+    const VectorX q = rng.uniform_vector(7, -2, 2);
+    const VectorX dq = rng.uniform_vector(7, -1, 1);
+    const VectorX tau = rng.uniform_vector(7, -5, 5);
+    ASSERT_TRUE(true_acceleration(model, forces, 0.0, q, dq, tau, ws));
+    // RNEA with the wrenches (eqs. 7-12) at the simulated q̈ must give back τ.
+    const VectorX tau_back = rnea(model, data, q, dq, ws.data.ddq, ws.wrenches);
+    EXPECT_LT((tau_back - tau).cwiseAbs().maxCoeff(), kAlgebraicTol * (1.0 + tau.cwiseAbs().maxCoeff()));
+    // τ_ext from the point Jacobians equals the RNEA difference.
+    const VectorX zero = VectorX::Zero(7);
+    const VectorX free = rnea(model, data, q, dq, zero);
+    const VectorX loaded = rnea(model, data, q, dq, zero, ws.wrenches);
+    EXPECT_LT((free - loaded - ws.tau_ext).cwiseAbs().maxCoeff(), kAlgebraicTol * 10);
+  }
+}
+
+TEST(ForceProfile, RampsUpAndDownInsideItsWindow) {
+  ForceProfile f;
+  f.start = 1.0;
+  f.end = 3.0;
+  f.ramp = 0.5;
+  EXPECT_EQ(f.scale(0.99), 0.0);
+  EXPECT_DOUBLE_EQ(f.scale(1.25), 0.5);
+  EXPECT_DOUBLE_EQ(f.scale(2.0), 1.0);
+  EXPECT_DOUBLE_EQ(f.scale(2.75), 0.5);
+  EXPECT_EQ(f.scale(3.01), 0.0);
+  f.ramp = 0.0;
+  EXPECT_EQ(f.scale(1.0), 1.0);
+}
+
+TEST(ForceProfile, FrameForceTurnsWithTheLinkAndWorldForceDoesNot) {
+  const Model model = test::random_model({.n = 3, .seed = 21});
+  Data data(model);
+  forward_kinematics(model, data, VectorX::Constant(3, 0.7));
+  ForceProfile in_frame;
+  in_frame.frame = "link2";
+  in_frame.force = Vector3(1, 2, 3);
+  in_frame.point = Vector3(0.1, 0.2, 0.3);
+  in_frame.resolve(model);
+  ForceProfile in_world = in_frame;
+  in_world.axes = ForceProfile::Axes::kWorld;
+  ExternalWrench a, b;
+  ASSERT_TRUE(in_frame.evaluate(0.0, data, a));
+  ASSERT_TRUE(in_world.evaluate(0.0, data, b));
+  const Pose& X_WB = data.X_WB[2];
+  EXPECT_TRUE(a.force_W.isApprox(X_WB.rotation * Vector3(1, 2, 3), 1e-14));
+  EXPECT_TRUE(b.force_W.isApprox(Vector3(1, 2, 3), 1e-14));
+  EXPECT_TRUE(a.point_W.isApprox(X_WB.act(Vector3(0.1, 0.2, 0.3)), 1e-14));
+  EXPECT_EQ(a.body, 2);
+}
+
+TEST(ForceProfile, UnknownFrameIsAnErrorNamingIt) {
+  const Model model = test::random_model({.n = 2, .seed = 1});
+  ForceProfile f;
+  f.frame = "tool0";
+  try {
+    f.resolve(model);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'tool0'"), std::string::npos);
+  }
+}
+
+TEST(SensorModel, QuantizesToTheEncoderResolution) {
+  EncoderModel enc{.resolution = 1e-3};
+  EXPECT_DOUBLE_EQ(enc.quantize(0.12345), 0.123);
+  EXPECT_DOUBLE_EQ(enc.quantize(-0.0006), -0.001);
+  EXPECT_EQ(EncoderModel{}.quantize(0.12345), 0.12345);
+}
+
+TEST(SensorModel, DifferentiatedVelocityOfARampIsItsSlope) {
+  JointSensor js(EncoderModel{.differentiate = true}, 2);
+  VectorX q(2), dq(2), qm(2), dqm(2);
+  for (int k = 0; k < 5; ++k) {
+    const double t = 0.002 * k;
+    q << 0.5 * t, -2.0 * t;
+    dq << 99, 99;  // the exact velocity must not be used after the first sample
+    js.measure(t, q, dq, qm, dqm);
+  }
+  EXPECT_NEAR(dqm[0], 0.5, 1e-12);
+  EXPECT_NEAR(dqm[1], -2.0, 1e-12);
+}
+
+TEST(SensorModel, NoiseHasTheConfiguredBiasAndStandardDeviation) {
+  BaseSensorModel s;
+  s.bias << 1, 2, 3, 0.1, 0.2, 0.3;
+  s.force_noise = Vector3(0.5, 0.5, 0.5);
+  s.moment_noise = Vector3(0.05, 0.05, 0.05);
+  Rng rng(7);
+  const int kDraws = 40000;
+  Vector6 sum = Vector6::Zero(), sum_sq = Vector6::Zero();
+  for (int k = 0; k < kDraws; ++k) {
+    const Vector6 r = s.measure(Vector6::Zero(), rng) - s.bias;
+    sum += r;
+    sum_sq += r.cwiseProduct(r);
+  }
+  const Vector6 mean = sum / kDraws;
+  const Vector6 sd = (sum_sq / kDraws).cwiseSqrt();
+  for (int k = 0; k < 6; ++k) {
+    const double sigma = k < 3 ? 0.5 : 0.05;
+    // 5 standard errors of the mean and of the standard deviation.
+    EXPECT_NEAR(mean[k], 0.0, 5 * sigma / std::sqrt(kDraws));
+    EXPECT_NEAR(sd[k], sigma, 5 * sigma / std::sqrt(2.0 * kDraws));
+  }
+}
+
+TEST(PerturbModel, EveryEntryStaysWithinTheFractionAndZerosStayZero) {
+  Model model = test::random_model({.n = 7, .seed = 30});
+  model.bodies[3].inertia.com.y() = 0.0;
+  model.bodies[5].inertia.inertia_com(0, 1) = model.bodies[5].inertia.inertia_com(1, 0) = 0.0;
+  const Model p = perturb_model(model, 0.01, 42);
+  int changed = 0;
+  for (int i = 0; i < model.num_bodies(); ++i) {
+    const Inertia& a = model.bodies[i].inertia;
+    const Inertia& b = p.bodies[i].inertia;
+    EXPECT_LE(std::abs(b.mass - a.mass), 0.01 * a.mass);
+    for (int k = 0; k < 3; ++k) EXPECT_LE(std::abs(b.com[k] - a.com[k]), 0.01 * std::abs(a.com[k]) + 0.0);
+    EXPECT_LE((b.inertia_com - a.inertia_com).cwiseAbs().maxCoeff(),
+              0.01 * a.inertia_com.cwiseAbs().maxCoeff());
+    EXPECT_TRUE(b.inertia_com.isApprox(b.inertia_com.transpose(), 0.0));
+    changed += b.mass != a.mass;
+    EXPECT_TRUE(p.joints[i].placement.is_approx(model.joints[i].placement, 0.0));
+  }
+  EXPECT_EQ(changed, model.num_bodies());  // link 0 included
+  EXPECT_EQ(p.bodies[3].inertia.com.y(), 0.0);
+  EXPECT_EQ(p.bodies[5].inertia.inertia_com(0, 1), 0.0);
+  EXPECT_EQ(p.bodies[5].inertia.inertia_com(1, 0), 0.0);
+}
+
+TEST(PerturbModel, IsDeterministicPerSeed) {
+  const Model model = test::random_model({.n = 4, .seed = 31});
+  const Model a = perturb_model(model, 0.01, 5);
+  const Model b = perturb_model(model, 0.01, 5);
+  const Model c = perturb_model(model, 0.01, 6);
+  EXPECT_EQ(a.bodies[2].inertia.mass, b.bodies[2].inertia.mass);
+  EXPECT_NE(a.bodies[2].inertia.mass, c.bodies[2].inertia.mass);
+  EXPECT_THROW((void)perturb_model(model, 0.7, 1), Error);
+}
+
+SinusoidalTrajectory small_sinusoid(int n) {
+  SinusoidalTrajectory tr;
+  tr.offset = VectorX::Constant(n, 0.3);
+  tr.amplitude = VectorX::Constant(n, 0.4);
+  tr.frequency = VectorX::LinSpaced(n, 0.2, 0.5);
+  tr.phase = VectorX::Zero(n);
+  return tr;
+}
+
+TEST(Controller, ComputedTorqueWithTheExactModelTracksTheTrajectory) {
+  const Model model = test::random_model({.n = 6, .seed = 40});
+  ComputedTorqueController ctl(model, small_sinusoid(6), pid_gains_triple_pole(6, 20.0));
+  SimulationConfig cfg;
+  cfg.duration = 1.0;
+  cfg.q0 = VectorX::Constant(6, 0.35);  // start off the trajectory
+  Simulator sim(model, ctl, cfg);
+  Sample s;
+  double first_error = 0.0, last_error = 0.0;
+  VectorX qd(6), dqd(6), ddqd(6);
+  while (sim.next(s)) {
+    small_sinusoid(6).evaluate(s.t, qd, dqd, ddqd);
+    const double e = (qd - s.q).cwiseAbs().maxCoeff();
+    if (s.t == 0.0) first_error = e;
+    last_error = e;
+  }
+  EXPECT_EQ(sim.num_samples(), 1001);
+  EXPECT_NEAR(first_error, 0.05, 1e-12);
+  EXPECT_LT(last_error, 1e-4);
+}
+
+TEST(Controller, IntegralTermRecoversThePathUnderAConstantForce) {
+  // A set point and a world-frame force: the disturbance is constant in joint space, so the
+  // integral term must bring the error back to zero (the paper's "recovers the path").
+  const Model model = test::random_model({.n = 6, .seed = 41});
+  SinusoidalTrajectory tr = small_sinusoid(6);
+  tr.amplitude.setZero();
+  ComputedTorqueController ctl(perturb_model(model, 0.01, 3), tr, pid_gains_triple_pole(6, 10.0));
+  SimulationConfig cfg;
+  cfg.duration = 3.0;
+  cfg.forces.resize(1);
+  cfg.forces[0].frame = "link6";
+  cfg.forces[0].axes = ForceProfile::Axes::kWorld;
+  cfg.forces[0].force = Vector3(20, 0, 0);
+  cfg.forces[0].point = Vector3(0, 0, 0.1);
+  cfg.forces[0].start = 0.5;
+  Simulator sim(model, ctl, cfg);
+  Sample s;
+  double peak = 0.0, last = 0.0;
+  VectorX qd(6), dqd(6), ddqd(6);
+  while (sim.next(s)) {
+    tr.evaluate(s.t, qd, dqd, ddqd);
+    last = (qd - s.q).cwiseAbs().maxCoeff();
+    peak = std::max(peak, last);
+    if (s.t >= 0.5) {
+      EXPECT_EQ(s.truth.link, "link6");
+      EXPECT_NEAR(s.truth.force.norm(), 20.0, 1e-9);
+    } else {
+      EXPECT_EQ(s.truth.link, "");
+    }
+  }
+  EXPECT_GT(peak, 1e-3);
+  EXPECT_LT(last, 0.01 * peak);
+}
+
+TEST(Simulator, BaseReadingEqualsWeightPlusForceForARobotHeldAtRest) {
+  // Exact model, zero gains, zero trajectory speed: the computed torque balances gravity, and
+  // a world-frame force balanced by nothing accelerates the arm; at t = 0 with q̇ = 0 the reading
+  // is f_m = m g⃗ + F − Σ m_i a_ci. Check the force part with a force on link 0, which does not
+  // move the arm: f_m = m g⃗ + F exactly.
+  const Model model = test::random_model({.n = 3, .seed = 50});
+  SinusoidalTrajectory tr = small_sinusoid(3);
+  tr.amplitude.setZero();
+  ComputedTorqueController ctl(model, tr, pid_gains_triple_pole(3, 10.0));
+  SimulationConfig cfg;
+  cfg.duration = 0.01;
+  cfg.forces.resize(1);
+  cfg.forces[0].frame = "link0";
+  cfg.forces[0].axes = ForceProfile::Axes::kWorld;
+  cfg.forces[0].force = Vector3(1, -2, 30);
+  Simulator sim(model, ctl, cfg);
+  Sample s;
+  while (sim.next(s)) {
+    const Vector3 expected = model.total_mass() * model.gravity + Vector3(1, -2, 30);
+    EXPECT_LT((s.sensor.head<3>() - expected).norm(), 1e-8);
+    EXPECT_LT(s.truth.tau_ext.norm(), 1e-12);  // Remark: a contact on link 0 has no residual
+  }
+}
+
+TEST(Metrics, AccumulatesErrorsInsideTheWindowOnly) {
+  MetricsAccumulator acc(MetricsWindow{.from = 1.0, .to = 3.0, .exclude = {{1.5, 2.0}}});
+  TruthSample truth{.contact = true, .body = 4, .contacts = 1, .force = Vector3(10, 0, 0),
+                    .moment = Vector3::Zero(), .point = Vector3(0, 0, 1)};
+  EstimateSample est;
+  est.contact = true;
+  est.body = 4;
+  est.has_force = true;
+  est.force = Vector3(13, 4, 0);  // error 5
+  est.has_line = true;
+  est.line_point = Vector3(0.5, 0, 0);
+  est.line_direction = Vector3(0, 0, 1);  // distance 0.5
+  for (int k = 0; k <= 40; ++k) {
+    const double t = 0.1 * k;
+    EstimateSample e = est;
+    if (t > 2.45 && t < 2.55) e.body = 3;  // one wrong link
+    acc.add(t, truth, e);
+  }
+  const Metrics m = acc.result();
+  // Samples 1.0..1.4 and 2.1..3.0 : 5 + 10 = 15.
+  EXPECT_EQ(m.samples, 15);
+  EXPECT_DOUBLE_EQ(m.force.rms(), 5.0);
+  EXPECT_DOUBLE_EQ(m.line.max, 0.5);
+  EXPECT_EQ(m.right_link, 14);
+  EXPECT_EQ(m.onsets, 1);
+  EXPECT_DOUBLE_EQ(m.delay_max, 0.0);
+}
+
+TEST(Metrics, CountsFalseAlarmsMissesAndDetectionDelay) {
+  MetricsAccumulator acc(MetricsWindow{});
+  TruthSample free_truth;
+  TruthSample contact{.contact = true, .body = 2, .contacts = 1, .force = Vector3(0, 0, 3),
+                      .moment = Vector3::Zero(), .point = Vector3::Zero()};
+  EstimateSample none, alarm;
+  alarm.contact = true;
+  alarm.body = 2;
+  alarm.has_force = true;
+  alarm.force = Vector3(0, 0, 3);
+  acc.add(0.0, free_truth, alarm);  // false alarm, error 3
+  acc.add(0.1, contact, none);      // onset, missed, error 3
+  acc.add(0.2, contact, none);      // missed
+  acc.add(0.3, contact, alarm);     // detected after 0.2 s, error 0
+  const Metrics m = acc.result();
+  EXPECT_EQ(m.false_alarms, 1);
+  EXPECT_EQ(m.missed, 2);
+  EXPECT_EQ(m.onsets_detected, 1);
+  EXPECT_NEAR(m.delay_max, 0.2, 1e-15);
+  EXPECT_NEAR(m.force.max, 3.0, 1e-15);
+  EXPECT_NEAR(m.isolation_accuracy(), 1.0 / 3.0, 1e-15);
+}
+
+}  // namespace
+}  // namespace extwrench::sim
