@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <tinyxml2.h>
 
 namespace extwrench::test {
@@ -99,6 +100,51 @@ inline std::string urdf_for_reference(const std::string& xml, const UrdfEditOpti
   tinyxml2::XMLPrinter printer;
   doc.Print(&printer);
   return printer.CStr();
+}
+
+/// A link's <inertial>, read directly from the URDF text.
+struct UrdfInertial {
+  double mass = 0.0;
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();       ///< origin xyz, link frame
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< origin rpy, link frame
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();   ///< about the CoM, inertial-frame axes
+};
+
+inline Eigen::Vector3d parse_triple(const char* text) {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  if (text != nullptr) {
+    std::istringstream in(text);
+    in >> v.x() >> v.y() >> v.z();
+  }
+  return v;
+}
+
+inline std::map<std::string, UrdfInertial> urdf_inertials(const std::string& xml) {
+  tinyxml2::XMLDocument doc;
+  doc.Parse(xml.c_str());
+  std::map<std::string, UrdfInertial> out;
+  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  for (auto* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link")) {
+    const tinyxml2::XMLElement* in = l->FirstChildElement("inertial");
+    if (in == nullptr) continue;
+    UrdfInertial u;
+    if (const auto* o = in->FirstChildElement("origin")) {
+      u.com = parse_triple(o->Attribute("xyz"));
+      const Eigen::Vector3d rpy = parse_triple(o->Attribute("rpy"));
+      u.rotation = (Eigen::AngleAxisd(rpy.z(), Eigen::Vector3d::UnitZ()) *
+                    Eigen::AngleAxisd(rpy.y(), Eigen::Vector3d::UnitY()) *
+                    Eigen::AngleAxisd(rpy.x(), Eigen::Vector3d::UnitX()))
+                       .toRotationMatrix();
+    }
+    u.mass = in->FirstChildElement("mass")->DoubleAttribute("value");
+    const auto* i = in->FirstChildElement("inertia");
+    const double ixx = i->DoubleAttribute("ixx"), ixy = i->DoubleAttribute("ixy"),
+                 ixz = i->DoubleAttribute("ixz"), iyy = i->DoubleAttribute("iyy"),
+                 iyz = i->DoubleAttribute("iyz"), izz = i->DoubleAttribute("izz");
+    u.inertia << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
+    out[l->Attribute("name")] = u;
+  }
+  return out;
 }
 
 /// Name of the root link (the one that is no joint's child).
