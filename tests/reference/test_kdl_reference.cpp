@@ -14,6 +14,8 @@
 //    translations, then x, y, z rotations, all at the sensor frame, massless) inserted between
 //    the ground and link 0, held at q = dq = ddq = 0. Their torques are the components of the
 //    wrench the ground transmits to link 0, in the sensor frame, moment about O_s: f_0 = −(f_m, n_m).
+#include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -28,6 +30,7 @@
 #include <kdl/frames.hpp>
 #include <kdl/jacobian.hpp>
 #include <kdl/jntspaceinertiamatrix.hpp>
+#include <kdl/rigidbodyinertia.hpp>
 #include <kdl/tree.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
 #include <kdl_parser/kdl_parser.hpp>
@@ -104,6 +107,7 @@ struct RobotCase {
   std::string tip;        ///< chain tip; the URDF is truncated to root -> tip when `truncate`
   bool truncate;
   std::string sensor_link;  ///< sensor frame from the URDF, or empty for kArbitrarySensor
+  bool dh = false;  ///< a DH YAML, compared with the SPEC table through KDL::Frame::DH
 };
 
 const Pose kArbitrarySensor =
@@ -113,17 +117,13 @@ std::string case_path(const RobotCase& c) {
   return std::string(c.shared ? EXTWRENCH_SHARED_DIR : EXTWRENCH_SOURCE_DIR) + "/" + c.urdf_path;
 }
 
-void build_reference(const RobotCase& c, Reference& ref) {
+void build_urdf_reference(const RobotCase& c, const LoadOptions& load, Reference& ref) {
   const std::string full = test::read_text(case_path(c));
   test::UrdfEditOptions ours_opt;
   if (c.truncate) ours_opt.tip = c.tip;
   // Our parser reads the file itself, or the truncated text when the chain is a sub-tree.
-  LoadOptions load;
-  load.load_meshes = false;
   ref.robot = c.truncate ? load_urdf_string(test::urdf_for_reference(full, ours_opt), c.name, load)
                          : load_urdf(case_path(c), load);
-  const Model& model = ref.robot.model;
-
   test::UrdfEditOptions kdl_opt = ours_opt;
   kdl_opt.new_root = kWorld;
   ASSERT_TRUE(kdl_parser::treeFromString(test::urdf_for_reference(full, kdl_opt), ref.tree));
@@ -140,6 +140,66 @@ void build_reference(const RobotCase& c, Reference& ref) {
     ASSERT_GE(fk.JntToCart(zero, f), 0);
     ref.X_WS = from_kdl(f);
   }
+}
+
+// SPEC section 5, typed in from the table (not from models/): standard DH, theta_i = q_i,
+// a_i = 0; CoM in cm and barycentric inertia in g m^2, in DH frame i.
+struct SpecLink {
+  double alpha, d, mass;
+  std::array<double, 3> com_cm;
+  std::array<double, 6> inertia_gm2;  // Ixx, Ixy, Ixz, Iyy, Iyz, Izz
+};
+const double kHalfPi = std::acos(0.0);
+const std::array<SpecLink, 7> kSpecTable{{
+    {kHalfPi, 0.0, 2.7, {0.1340, -8.7777, 2.6220}, {16.341, 0.003, 0.001, 5.026, -3.533, 16.173}},
+    {-kHalfPi, 0.0, 2.7, {0.1340, 2.6220, 8.7777}, {16.341, 0.001, 0.003, 16.173, 3.533, 5.026}},
+    {-kHalfPi, 0.40, 2.7, {0.1340, 8.7777, 2.6220}, {16.341, 0.003, 0.001, 5.026, 3.533, 16.173}},
+    {kHalfPi, 0.0, 2.7, {0.1340, 2.6220, 8.7777}, {16.341, 0.001, 0.003, 16.173, 3.533, 5.026}},
+    {kHalfPi, 0.39, 2.7, {0.1340, -8.7777, 2.6220}, {16.341, 0.003, 0.001, 5.026, -3.533, 16.173}},
+    {-kHalfPi, 0.0, 1.7, {0.0, 0.5, 0.0}, {5.0, 0, 0, 3.6, 0, 4.7}},
+    {0.0, 0.078, 0.3, {0.0, 0.0, -2.0}, {1.0, 0, 0, 1.0, 0, 1.0}},
+}};
+
+KDL::RigidBodyInertia spec_inertia(double mass, const std::array<double, 3>& com_m,
+                                   const std::array<double, 6>& i_kgm2) {
+  // KDL::RotationalInertia(Ixx, Iyy, Izz, Ixy, Ixz, Iyz), about the CoM here.
+  return KDL::RigidBodyInertia(
+      mass, KDL::Vector(com_m[0], com_m[1], com_m[2]),
+      KDL::RotationalInertia(i_kgm2[0], i_kgm2[3], i_kgm2[5], i_kgm2[1], i_kgm2[2], i_kgm2[4]));
+}
+
+/// The paper's arm as KDL segments: link 0 (m0 = 2 kg, CoM 0.15 m above O_s = 0.16 m below
+/// O_0, inertia diag(20, 20, 10) g m^2), then KDL::Frame::DH(a, alpha, d, theta) per joint.
+KDL::Chain spec_dh_chain() {
+  KDL::Chain chain;
+  chain.addSegment(KDL::Segment("link0", KDL::Joint(KDL::Joint::Fixed), KDL::Frame::Identity(),
+                                spec_inertia(2.0, {0, 0, -0.16}, {0.020, 0, 0, 0.020, 0, 0.010})));
+  for (std::size_t i = 0; i < kSpecTable.size(); ++i) {
+    const SpecLink& l = kSpecTable[i];
+    std::array<double, 3> com_m{};
+    std::array<double, 6> i_kgm2{};
+    for (int k = 0; k < 3; ++k) com_m[k] = 0.01 * l.com_cm[k];
+    for (int k = 0; k < 6; ++k) i_kgm2[k] = 1e-3 * l.inertia_gm2[k];
+    const std::string n = std::to_string(i + 1);
+    chain.addSegment(KDL::Segment("link" + n, KDL::Joint("joint" + n, KDL::Joint::RotZ),
+                                  KDL::Frame::DH(0.0, l.alpha, l.d, 0.0),
+                                  spec_inertia(l.mass, com_m, i_kgm2)));
+  }
+  return chain;
+}
+
+void build_reference(const RobotCase& c, Reference& ref) {
+  LoadOptions load;
+  load.load_meshes = false;
+  if (c.dh) {
+    ref.robot = load_robot(case_path(c), load);
+    ref.chain = spec_dh_chain();
+    ref.X_WS = Pose::from_xyz_rpy(Vector3(0, 0, -0.31), Vector3::Zero());  // O_0 = O_s + 0.31 z
+  } else {
+    build_urdf_reference(c, load, ref);
+  }
+  if (::testing::Test::HasFatalFailure()) return;
+  const Model& model = ref.robot.model;
 
   const KDL::Frame X_WS = to_kdl(ref.X_WS);
   ref.sensor_chain.addSegment(KDL::Segment("ref_to_sensor", KDL::Joint(KDL::Joint::Fixed), X_WS));
@@ -173,6 +233,7 @@ class KdlReference : public ::testing::TestWithParam<RobotCase> {
       GTEST_SKIP() << "shared models absent: " << case_path(GetParam());
     }
     build_reference(GetParam(), ref_);
+    if (HasFatalFailure()) return;
   }
 
   const Model& model() const { return ref_.robot.model; }
@@ -369,7 +430,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         RobotCase{"paper_arm", "models/paper_arm.urdf", false, "link7", false, "sensor"},
         RobotCase{"panda_chain", "models/franka_panda/urdf_example-robot-data/urdf/panda.urdf",
-                  true, "panda_link7", true, ""}),
+                  true, "panda_link7", true, ""},
+        RobotCase{"paper_arm_dh", "models/paper_arm.yaml", false, "link7", false, "", true}),
     [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace
