@@ -9,6 +9,7 @@
 #include <limits>
 #include <ostream>
 #include <system_error>
+#include <unordered_map>
 
 #include "extwrench/core/error.hpp"
 
@@ -183,24 +184,25 @@ void CsvReader::read_header() {
   }
   split_line();
   header_.assign(cells_.begin(), cells_.end());
+  column_index_.clear();  // a hash map: wide logs have many columns
+  column_index_.reserve(header_.size());
   for (std::size_t k = 0; k < header_.size(); ++k) {
     if (header_[k].empty()) {
       throw Error(where() + "column " + std::to_string(k + 1) + " of the header has an empty name");
     }
-    for (std::size_t j = 0; j < k; ++j) {
-      if (header_[j] == header_[k]) {
-        throw Error(where() + "column " + std::to_string(k + 1) + " '" + header_[k] +
-                    "' appears twice in the header (also column " + std::to_string(j + 1) + ")");
-      }
+    const auto [it, inserted] = column_index_.emplace(header_[k], static_cast<int>(k));
+    if (!inserted) {
+      throw Error(where() + "column " + std::to_string(k + 1) + " '" + header_[k] +
+                  "' appears twice in the header (also column " + std::to_string(it->second + 1) + ")");
     }
   }
   cells_.clear();
 }
 
 std::optional<int> CsvReader::find_column(std::string_view column_name) const {
-  const auto it = std::find(header_.begin(), header_.end(), column_name);
-  if (it == header_.end()) return std::nullopt;
-  return static_cast<int>(it - header_.begin());
+  const auto it = column_index_.find(std::string(column_name));
+  if (it == column_index_.end()) return std::nullopt;
+  return it->second;
 }
 
 int CsvReader::column(std::string_view column_name) const {

@@ -27,6 +27,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 namespace extwrench {
@@ -90,6 +91,7 @@ class CsvReader {
   std::istream* in_ = nullptr;
   std::string name_;
   std::vector<std::string> header_;
+  std::unordered_map<std::string, int> column_index_;
 
   // Read buffer: lines are cut out of it with memchr rather than std::getline, which is the
   // hot path when replaying long logs.
