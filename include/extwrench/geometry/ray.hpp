@@ -45,7 +45,7 @@ struct ShapeClosestPoint {
 /// The surface point of `shape` nearest to the line origin_S + λ direction_S (unit direction,
 /// shape frame). If the line meets the surface: its first (smallest λ) hit, distance 0.
 /// Spheres and capsules in closed form; boxes and cylinders by a bounded golden-section search
-/// of the convex line-to-solid distance (80 iterations, ~1e-14 relative); meshes exactly, from
+/// of the convex line-to-solid distance (64 iterations); meshes exactly, from
 /// the triangle edges (for a line that misses a triangle, the nearest point of the triangle is
 /// on an edge). A mesh shape without a mesh gives distance = +inf.
 [[nodiscard]] ShapeClosestPoint closest_point_to_line(const CollisionShape& shape,
