@@ -1,0 +1,90 @@
+#include "extwrench/estimation/contact_detector.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "extwrench/core/error.hpp"
+
+namespace extwrench {
+namespace {
+// Time stamps are sums of floating steps: a duration reached up to this slack counts as reached.
+constexpr double kTimeSlack = 1e-9;  // [s]
+}  // namespace
+
+ContactDetector::ContactDetector(const DetectionOptions& options, int n) : options_(options) {
+  const VectorX& t = options.tau_min;
+  if (t.size() != 1 && t.size() != n) {
+    throw Error("detection.tau_min: expected 1 or " + std::to_string(n) + " values, got " +
+                std::to_string(t.size()));
+  }
+  tau_min_ = t.size() == 1 ? VectorX::Constant(n, t[0]) : t;
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(tau_min_[i]) || !(tau_min_[i] > 0.0)) {
+      throw Error("detection.tau_min[" + std::to_string(i) + "]: expected a finite value > 0");
+    }
+  }
+  if (!std::isfinite(options.f_min) || !(options.f_min > 0.0)) {
+    throw Error("detection.f_min: expected a finite value > 0");
+  }
+  if (!(options.release_ratio > 0.0 && options.release_ratio <= 1.0)) {
+    throw Error("detection.release_ratio: expected a value in (0, 1]");
+  }
+  if (!std::isfinite(options.min_duration) || options.min_duration < 0.0) {
+    throw Error("detection.min_duration: expected a finite value >= 0 [s]");
+  }
+  joint_over_.setConstant(n, false);
+}
+
+void ContactDetector::reset() noexcept {
+  joint_over_.setConstant(false);
+  base_over_ = false;
+  declared_ = false;
+  have_edge_ = false;
+  last_link_ = -1;
+  result_ = DetectionResult{};
+}
+
+const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const VectorX>& tau_ext,
+                                               double base_force_norm) noexcept {
+  const double ratio = options_.release_ratio;
+  int link = -1;
+  for (Eigen::Index i = 0; i < tau_min_.size(); ++i) {
+    // Hysteresis: once over, a joint stays over until it falls below ratio × τ_min.
+    const double level = joint_over_[i] ? ratio * tau_min_[i] : tau_min_[i];
+    joint_over_[i] = std::abs(tau_ext[i]) > level;
+    if (joint_over_[i]) link = static_cast<int>(i) + 1;  // largest joint index over threshold
+  }
+  if (std::isfinite(base_force_norm)) {
+    const double level = base_over_ ? ratio * options_.f_min : options_.f_min;
+    base_over_ = base_force_norm > level;
+  } else {
+    base_over_ = false;
+  }
+  const bool base_only = base_over_ && link < 0;
+  if (base_only) link = 0;  // a contact no joint feels is on link 0 (SPEC §2)
+  const bool raw = link >= 0;
+
+  // Debounce both edges: the raw state must hold for min_duration before it is declared.
+  if (raw != declared_) {
+    if (!have_edge_) {
+      have_edge_ = true;
+      edge_time_ = t;
+    }
+    if (t - edge_time_ >= options_.min_duration - kTimeSlack) {
+      declared_ = raw;
+      have_edge_ = false;
+    }
+  } else {
+    have_edge_ = false;
+  }
+  if (raw) last_link_ = link;
+
+  result_.contact = declared_;
+  result_.pending = raw != declared_;
+  result_.raw = raw;
+  result_.base_only = base_only;
+  result_.link = declared_ ? last_link_ : -1;
+  return result_;
+}
+
+}  // namespace extwrench
