@@ -188,6 +188,64 @@ TEST(RayMesh, ScaleIsAppliedPerAxisAndMirroringKeepsNormalsOutward) {
   }
 }
 
+TEST(RayMesh, LinesThroughSharedEdgesAndCornersCountEachCrossingOnce) {
+  const Vector3 size(0.5, 0.25, 0.75);
+  const test::SimpleMesh box = test::box_mesh(size);
+  const CollisionShape embree =
+      mesh_shape(make_triangle_mesh(test::vertex_matrix(box), test::triangle_matrix(box), "box"));
+  const CollisionShape brute = brute_force_copy(embree);
+  const Vector3 h = 0.5 * size;
+  struct Line {
+    Vector3 o, u;
+    double entry, exit;
+  };
+  const Line lines[] = {
+      // Through the face centres: on the diagonal shared by each face's two triangles.
+      {Vector3(-2.0, 0.0, 0.0), Vector3::UnitX(), 2.0 - h.x(), 2.0 + h.x()},
+      {Vector3(0.0, 0.0, 2.0), -Vector3::UnitZ(), 2.0 - h.z(), 2.0 + h.z()},
+      // Through two opposite corners, where three faces (up to six triangles) meet.
+      {-2.0 * h, h.normalized(), h.norm(), 3.0 * h.norm()},
+  };
+  for (const CollisionShape* shape : {&embree, &brute}) {
+    for (const Line& line : lines) {
+      std::array<ShapeHit, 8> hits;
+      ASSERT_EQ(intersect_line_with_shape(*shape, line.o, line.u, hits), 2);
+      EXPECT_NEAR(hits[0].lambda, line.entry, 1e-12);
+      EXPECT_NEAR(hits[1].lambda, line.exit, 1e-12);
+    }
+  }
+}
+
+TEST(RayMesh, ManyCrossingsKeepTheSmallestInTheBufferAndTheExtremesInTheBodyQuery) {
+  // 40 unit-spaced cubes in a row along x, in one mesh: a line along x crosses it 80 times.
+  test::SimpleMesh row;
+  for (int i = 0; i < 40; ++i) {
+    const test::SimpleMesh cube = test::box_mesh(Vector3(0.5, 0.5, 0.5), Vector3(i, 0.0, 0.0));
+    const int offset = static_cast<int>(row.vertices.size());
+    row.vertices.insert(row.vertices.end(), cube.vertices.begin(), cube.vertices.end());
+    for (const auto& t : cube.triangles)
+      row.triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
+  }
+  GeometryModel g;
+  g.shapes = {
+      mesh_shape(make_triangle_mesh(test::vertex_matrix(row), test::triangle_matrix(row), "row"))};
+  g.body_shapes = {{0}};
+  const Vector3 o(-10.0, 0.1, -0.05);
+  std::array<ShapeHit, 8> hits;
+  ASSERT_EQ(intersect_line_with_shape(g.shapes[0], o, Vector3::UnitX(), hits), 8);
+  for (int i = 0; i < 8; ++i) {
+    // Cube k spans x ∈ [k − 0.25, k + 0.25]: crossings at 10 + k ∓ 0.25.
+    EXPECT_NEAR(hits[static_cast<std::size_t>(i)].lambda, 10.0 + i / 2 + (i % 2 ? 0.25 : -0.25),
+                1e-12);
+  }
+  const SurfacePointResult r =
+      intersect_line_with_body(g, 0, Pose::identity(), o, Vector3::UnitX());
+  ASSERT_TRUE(r.hit);
+  EXPECT_EQ(r.num_hits, 80);
+  EXPECT_NEAR(r.entry.lambda, 9.75, 1e-12);
+  EXPECT_NEAR(r.exit.lambda, 49.25, 1e-12);
+}
+
 TEST(RayMesh, LoadingErrorsNameTheFile) {
   const std::filesystem::path missing =
       std::filesystem::temp_directory_path() / "extwrench_no_such_mesh.stl";

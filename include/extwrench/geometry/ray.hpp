@@ -63,7 +63,9 @@ struct LineHit {
 /// Result of intersect_line_with_body. On failure or miss, entry/exit are NaN with shape −1.
 struct SurfacePointResult {
   bool hit = false;  ///< the line crosses (or touches) a shape of the body
-  int num_hits = 0;  ///< intersections over all shapes (2 for one convex shape)
+  /// Intersections over all shapes (2 for one convex shape). Past 32 crossings of one shape,
+  /// coincident ones may be counted twice; entry and exit stay exact.
+  int num_hits = 0;
   LineHit entry;     ///< smallest λ: the pushing point (21)
   LineHit exit;      ///< largest λ: the pulling point
   /// Hit: the entry point, distance 0. Miss: the surface point nearest to the line, with the
