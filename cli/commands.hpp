@@ -27,6 +27,8 @@ class UsageError : public std::runtime_error {
 
 void register_info(CLI::App& app);
 void register_dynamics(CLI::App& app);
+void register_estimate(CLI::App& app);
+void register_simulate(CLI::App& app);
 
 // ---- helpers shared by subcommands (common.cpp) --------------------------------------------
 

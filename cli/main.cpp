@@ -43,6 +43,8 @@ int main(int argc, char** argv) {
   // One line per subcommand; each lives in its own file.
   extwrench::cli::register_info(app);
   extwrench::cli::register_dynamics(app);
+  extwrench::cli::register_estimate(app);
+  extwrench::cli::register_simulate(app);
 
   if (argc <= 1) {  // a newcomer typing just `extwrench` gets the help, not an error
     std::cout << app.help();

@@ -1,0 +1,106 @@
+// extwrench estimate: replays a robot log (real or simulated) through the contact estimator.
+#include <iostream>
+#include <memory>
+
+#include <unistd.h>
+
+#include "commands.hpp"
+#include "extwrench/core/error.hpp"
+#include "extwrench/io/csv.hpp"
+#include "extwrench/io/estimator_config.hpp"
+#include "extwrench/io/replay.hpp"
+
+namespace extwrench::cli {
+namespace {
+
+struct EstimateOptions {
+  std::filesystem::path config;
+  std::filesystem::path log;
+  std::filesystem::path out;
+  double metrics_from = 0.0;
+  double metrics_to = std::numeric_limits<double>::infinity();
+  std::vector<std::string> exclude;
+  bool surface_metrics = false;
+  bool no_figures = false;
+  int plot_points = 2000;
+  std::vector<std::filesystem::path> package_path;
+};
+
+std::pair<double, double> parse_interval(const std::string& text) {
+  const auto colon = text.find(':');
+  const auto a = colon == std::string::npos ? std::nullopt : parse_number(text.substr(0, colon));
+  const auto b = colon == std::string::npos ? std::nullopt : parse_number(text.substr(colon + 1));
+  if (!a || !b || !(*a < *b)) {
+    throw UsageError("--exclude: expected FROM:TO in seconds with FROM < TO, got '" + text + "'");
+  }
+  return {*a, *b};
+}
+
+void run_estimate(const EstimateOptions& opt) {
+  sim::MetricsWindow window{opt.metrics_from, opt.metrics_to, {}};
+  std::string description = "from t = " + CsvWriter::format(opt.metrics_from) + " s";
+  for (const auto& e : opt.exclude) {
+    window.exclude.push_back(parse_interval(e));
+    description += ", excluding [" + e + "] s";
+  }
+  if (!(opt.plot_points >= 10)) throw UsageError("--plot-points must be at least 10");
+  LoadOptions load;
+  load.package_path = opt.package_path;
+  const EstimatorConfig config = load_estimator_config(opt.config, load);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(opt.log, ec)) throw Error(opt.log.string() + ": no such log file");
+
+  ReplayOptions replay;
+  replay.log = opt.log;
+  replay.out_dir = opt.out;
+  replay.name = opt.config.stem().string() == "config" && opt.config.has_parent_path()
+                    ? opt.config.parent_path().filename().string()
+                    : opt.config.stem().string();
+  replay.config_label = opt.config.string();
+  replay.windows.push_back({"window", description, window});
+  replay.surface_metrics = opt.surface_metrics;
+  replay.figures = !opt.no_figures;
+  replay.plot_points = opt.plot_points;
+  replay.progress = isatty(STDERR_FILENO) != 0;
+  const ReplayResult r = replay_log(config.robot.model, config.robot.geometry, config.options, replay);
+
+  std::cout << "extwrench estimate: " << r.rows << " rows -> " << (opt.out / "estimates.csv").string() << "\n";
+  if (r.has_truth) {
+    const sim::Metrics& m = r.report.windows.front().metrics;
+    std::cout << "  metrics (" << description << "): force error RMS " << fmt(m.force.rms()) << " N, max "
+              << fmt(m.force.max) << " N; line of action RMS " << fmt(m.line.rms()) << " m; right link "
+              << fmt(100.0 * m.isolation_accuracy()) << " %; false alarms " << m.false_alarms << "\n"
+              << "  -> " << (opt.out / "metrics.json").string() << "\n";
+  }
+  for (const auto& f : r.figures) std::cout << "  figure: " << f.string() << "\n";
+}
+
+}  // namespace
+
+void register_estimate(CLI::App& app) {
+  auto opt = std::make_shared<EstimateOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "estimate",
+      "Replay a robot log through the contact estimator: estimates.csv, and with truth columns "
+      "metrics.json; PNG figures (docs/log_format.md)");
+  sub->add_option("--config", opt->config, "Estimator configuration (YAML, docs/config.md)")
+      ->required()
+      ->type_name("CONFIG.yaml");
+  sub->add_option("--log", opt->log, "Robot log (CSV, docs/log_format.md)")->required()->type_name("LOG.csv");
+  sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
+  sub->add_option("--metrics-from", opt->metrics_from, "Start of the metrics window [s] (default 0)")
+      ->type_name("T");
+  sub->add_option("--metrics-to", opt->metrics_to, "End of the metrics window [s] (default: end of log)")
+      ->type_name("T");
+  sub->add_option("--exclude", opt->exclude, "Exclude FROM:TO [s] from the metrics (repeatable)")
+      ->type_name("FROM:TO");
+  sub->add_flag("--surface-metrics", opt->surface_metrics,
+                "Report the surface-point error (when the true points lie on the links' surfaces)");
+  sub->add_flag("--no-figures", opt->no_figures, "Do not draw figures (no gnuplot needed)");
+  sub->add_option("--plot-points", opt->plot_points, "Points per figure after decimation (default 2000)")
+      ->type_name("N");
+  add_package_path_option(*sub, opt->package_path);
+  sub->callback([opt]() { run_estimate(*opt); });
+}
+
+}  // namespace extwrench::cli

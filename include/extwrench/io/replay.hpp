@@ -1,0 +1,56 @@
+// Replaying a robot log through the contact estimator: the engine of `extwrench estimate`, and
+// of `extwrench simulate`, which replays the log it just wrote through the very same code.
+// Streaming: memory does not depend on the log's length (figures are decimated).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "extwrench/estimation/contact_estimator.hpp"
+#include "extwrench/io/metrics_json.hpp"
+
+namespace extwrench {
+
+struct ReplayWindow {
+  std::string name;
+  std::string description;
+  sim::MetricsWindow window;
+};
+
+struct ReplayOptions {
+  std::filesystem::path log;
+  std::filesystem::path out_dir;        ///< estimates.csv, metrics.json, figures go here
+  std::string name;                     ///< run name in titles and the report (scheme)
+  std::string config_label;             ///< the configuration file, for the report
+  /// Metric windows; empty: one window over the whole log.
+  std::vector<ReplayWindow> windows;
+  bool surface_metrics = false;         ///< report the surface-point error
+  bool figures = true;
+  int plot_points = 2000;               ///< decimation target per figure
+  int snapshots = 4;                    ///< instants of the 3-D view
+  bool progress = false;                ///< progress line on stderr
+  bool warn_ignored_columns = true;     ///< list unknown log columns once on stderr
+};
+
+struct ReplayResult {
+  long rows = 0;
+  bool has_truth = false;
+  MetricsReport report;                           ///< empty windows without truth
+  std::vector<std::filesystem::path> figures;
+};
+
+/// Reads `options.log` row by row, runs a ContactEstimator built from (model, geometry,
+/// estimator) on it, writes out_dir/estimates.csv, and with truth columns out_dir/metrics.json;
+/// figures (PNG, gnuplot) unless disabled. The first row resets the estimator (its output row is
+/// "free" with a zero residual). Throws extwrench::Error on malformed logs (file, line, column)
+/// and when the log lacks the columns the configuration's sensor needs.
+ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
+                        const EstimatorOptions& estimator, const ReplayOptions& options);
+
+/// cond(J) = σ_max / σ_min of J (6 × l) of the origin O_l of body l, world frame, SI units:
+/// the "condition number of J of O_6" of the paper's Fig. 10 when l = 6. After forward
+/// kinematics on `data`; allocates (an SVD): not for the real-time path.
+[[nodiscard]] double origin_jacobian_condition(const Model& model, const Data& data, int body);
+
+}  // namespace extwrench

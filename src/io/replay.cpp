@@ -1,0 +1,377 @@
+#include "extwrench/io/replay.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <Eigen/SVD>
+#include <unistd.h>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/io/log.hpp"
+#include "extwrench/io/plot.hpp"
+
+namespace extwrench {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Columns of the decimated plot buffer.
+enum Col : int {
+  kT = 0, kContact, kF = 2, kFt = 5, kL = 8, kDir = 11, kP = 14, kPt = 17, kCond = 20,
+  kCondTrue, kTrueContact, kErrF, kQ  // q1..qn follow
+};
+
+sim::TruthSample truth_of(const sim::Sample& s) {
+  sim::TruthSample t;
+  t.contact = s.truth.body >= 0;
+  t.body = s.truth.body;
+  t.contacts = s.truth.contacts;
+  t.force = s.truth.force;
+  t.moment = s.truth.moment;
+  t.point = s.truth.point;
+  return t;
+}
+
+sim::EstimateSample estimate_of(const ContactEstimate& e) {
+  sim::EstimateSample s;
+  s.contact = e.contact;
+  s.body = e.link;
+  s.has_force = e.has(EstimateFlag::kForce);
+  s.force = e.force_W;
+  s.has_moment = e.has(EstimateFlag::kMoment);
+  s.moment = e.moment_W;
+  s.has_line = e.has(EstimateFlag::kLineOfAction);
+  s.line_point = e.line_point_W;
+  s.line_direction = e.line_direction_W;
+  s.has_surface_point = e.has(EstimateFlag::kSurfacePoint);
+  s.surface_point = e.point_W;
+  return s;
+}
+
+class Progress {
+ public:
+  Progress(bool on, std::string name) : on_(on), name_(std::move(name)) {}
+  void update(long rows, double t) {
+    if (!on_ || (rows & 1023) != 0) return;
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_ < std::chrono::milliseconds(250)) return;
+    last_ = now;
+    std::fprintf(stderr, "\r  %s: replayed %ld rows (t = %.1f s)   ", name_.c_str(), rows, t);
+    std::fflush(stderr);
+    shown_ = true;
+  }
+  void done() {
+    if (shown_) std::fprintf(stderr, "\r%*s\r", 60, "");
+  }
+
+ private:
+  bool on_;
+  std::string name_;
+  std::chrono::steady_clock::time_point last_{};
+  bool shown_ = false;
+};
+
+std::string title_of(const ReplayOptions& o) { return o.name.empty() ? std::string("estimate") : o.name; }
+
+void write_script(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path);
+  if (!out) throw Error(path.string() + ": cannot create the file");
+  out << text;
+}
+
+// ---- figures ------------------------------------------------------------------------------
+
+std::vector<std::filesystem::path> make_figures(const Model& model, const Decimator& dec,
+                                                const ReplayOptions& o, bool truth) {
+  std::vector<std::filesystem::path> pngs;
+  const std::filesystem::path dir = o.out_dir;
+  const std::filesystem::path data = dir / "plot_data.txt";
+  dec.write(data);
+  const std::string d = gnuplot_quote(data.filename().string());
+  const std::string title = gnuplot_quote(title_of(o));
+  const int n = model.nq();
+  auto col = [](int c) { return std::to_string(c + 1); };
+
+  {  // Fig. 5: joint positions
+    std::ostringstream s;
+    s << gnuplot_png_preamble(dir / "joints.png") << "set title " << gnuplot_quote("Joint positions — " + title_of(o))
+      << "\nset xlabel 't [s]'\nset ylabel 'q_i [rad]'\nplot ";
+    for (int i = 0; i < n; ++i) {
+      s << (i ? ", " : "") << d << " using 1:" << col(kQ + i) << " with lines lw 2 title 'q_" << i + 1 << "'";
+    }
+    s << "\n";
+    write_script(dir / "joints.gp", s.str());
+    run_gnuplot(dir / "joints.gp");
+    pngs.push_back(dir / "joints.png");
+  }
+  const char* axis[] = {"x", "y", "z"};
+  {  // Figs. 6 / 8: estimated and true force, and the error norm
+    std::ostringstream s;
+    s << gnuplot_png_preamble(dir / "force.png", 1000, 1000)
+      << "set multiplot layout 4,1 title " << gnuplot_quote("External force, world frame — " + title_of(o)) << "\n"
+      << "set key inside right top horizontal\nset lmargin 10\n";
+    for (int k = 0; k < 3; ++k) {
+      s << "set ylabel 'F_" << axis[k] << " [N]'\nunset xlabel\nplot " << d << " using 1:" << col(kF + k)
+        << " with lines lw 2 lc rgb '#1f77b4' title 'estimated'";
+      if (truth) s << ", " << d << " using 1:" << col(kFt + k) << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true'";
+      s << "\n";
+    }
+    if (truth) {
+      s << "set ylabel '|F_{est} - F| [N]'\nset xlabel 't [s]'\nset logscale y\nplot " << d << " using 1:"
+        << col(kErrF) << " with lines lw 2 lc rgb '#2ca02c' title 'force error'\nunset logscale y\n";
+    } else {
+      s << "set ylabel 'contact'\nset xlabel 't [s]'\nset yrange [-0.1:1.1]\nplot " << d << " using 1:"
+        << col(kContact) << " with steps lw 2 title 'contact detected'\n";
+    }
+    s << "unset multiplot\n";
+    write_script(dir / "force.gp", s.str());
+    run_gnuplot(dir / "force.gp");
+    pngs.push_back(dir / "force.png");
+  }
+  {  // Figs. 7 / 9: p̂ of eq. (20) and the true contact point
+    std::ostringstream s;
+    s << gnuplot_png_preamble(dir / "line_point.png", 1000, 850)
+      << "set multiplot layout 3,1 title "
+      << gnuplot_quote("Point of the line of action p̂ (eq. 20), world frame — " + title_of(o)) << "\n"
+      << "set key inside right top horizontal\nset lmargin 10\n";
+    for (int k = 0; k < 3; ++k) {
+      s << "set ylabel 'p_" << axis[k] << " [m]'\n" << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n")
+        << "plot " << d << " using 1:" << col(kL + k) << " with lines lw 2 lc rgb '#1f77b4' title 'estimated p̂'";
+      if (truth) s << ", " << d << " using 1:" << col(kPt + k) << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true point'";
+      s << "\n";
+    }
+    s << "unset multiplot\n";
+    write_script(dir / "line_point.gp", s.str());
+    run_gnuplot(dir / "line_point.gp");
+    pngs.push_back(dir / "line_point.png");
+  }
+  {  // Fig. 10: condition numbers
+    std::ostringstream s;
+    s << gnuplot_png_preamble(dir / "condition.png", 1000, 600) << "set title "
+      << gnuplot_quote("Condition number — " + title_of(o))
+      << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\nset logscale y\nset key inside left top\nplot "
+      << d << " using 1:" << col(kCond) << " with lines lw 2 lc rgb '#1f77b4' title 'Jacobian inverted by the estimator'";
+    if (truth) {
+      s << ", " << d << " using 1:" << col(kCondTrue)
+        << " with lines lw 2 dt 2 lc rgb '#d62728' title 'J of O_l, l = true contact link'";
+    }
+    s << "\n";
+    write_script(dir / "condition.gp", s.str());
+    run_gnuplot(dir / "condition.gp");
+    pngs.push_back(dir / "condition.png");
+  }
+  {  // 3-D view at a few instants
+    std::vector<int> rows;
+    const int available = dec.rows();
+    const int count = std::max(1, std::min(o.snapshots, available));
+    for (int k = 0; k < count && available > 0; ++k) {
+      rows.push_back(static_cast<int>((static_cast<long long>(available - 1) * (2 * k + 1)) / (2 * count)));
+    }
+    Data data(model);
+    std::ofstream out(dir / "robot3d.txt");
+    // Blocks per snapshot (gnuplot index): 4k skeleton, 4k+1 true point, 4k+2 line, 4k+3 surface point.
+    double extent = 0.3;
+    for (const int r : rows) {
+      const double* row = dec.row(r);
+      VectorX q(n);
+      for (int i = 0; i < n; ++i) q[i] = row[kQ + i];
+      forward_kinematics(model, data, q);
+      for (int b = 0; b < model.num_bodies(); ++b) {
+        const Vector3& p = data.X_WB[b].translation;
+        out << p.x() << " " << p.y() << " " << p.z() << "\n";
+        extent = std::max(extent, p.cwiseAbs().maxCoeff());
+      }
+      out << "\n\n";
+      if (truth && row[kTrueContact] > 0.5) {
+        out << row[kPt] << " " << row[kPt + 1] << " " << row[kPt + 2] << "\n";
+      } else {
+        out << "NaN NaN NaN\n";
+      }
+      out << "\n\n";
+      if (std::isfinite(row[kL]) && std::isfinite(row[kDir])) {
+        for (const double lambda : {-0.3, 0.3}) {
+          out << row[kL] + lambda * row[kDir] << " " << row[kL + 1] + lambda * row[kDir + 1] << " "
+              << row[kL + 2] + lambda * row[kDir + 2] << "\n";
+        }
+      } else {
+        out << "NaN NaN NaN\n";
+      }
+      out << "\n\n";
+      if (std::isfinite(row[kP])) {
+        out << row[kP] << " " << row[kP + 1] << " " << row[kP + 2] << "\n";
+      } else {
+        out << "NaN NaN NaN\n";
+      }
+      out << "\n\n";
+    }
+    out.close();
+    std::ostringstream s;
+    const int cols = rows.size() > 1 ? 2 : 1;
+    const int lines = static_cast<int>((rows.size() + 1) / 2);
+    s << gnuplot_png_preamble(dir / "robot3d.png", 1100, 550 * std::max(1, lines))
+      << "set multiplot layout " << std::max(1, lines) << "," << cols << " title "
+      << gnuplot_quote("Robot, true contact point and estimated line of action — " + title_of(o)) << "\n"
+      << "set view 65,35\nset view equal xyz\n"
+      << "set xrange [" << -extent << ":" << extent << "]\nset yrange [" << -extent << ":" << extent
+      << "]\nset zrange [" << -0.35 << ":" << extent + 0.1 << "]\n"
+      << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]'\nset key at screen 1, screen 1 top right\n"
+      << "set ticslevel 0\n";
+    for (std::size_t k = 0; k < rows.size(); ++k) {
+      const double t = dec.row(rows[k])[kT];
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "t = %.2f s", t);
+      s << "set title '" << buf << "'\n"
+        << "splot 'robot3d.txt' index " << 4 * k << " with linespoints lw 4 pt 7 ps 1 lc rgb '#555555' title "
+        << (k == 0 ? "'links (joint frame origins)'" : "''") << ", "
+        << "'' index " << 4 * k + 1 << " with points pt 7 ps 2 lc rgb '#d62728' title " << (k == 0 ? "'true point'" : "''") << ", "
+        << "'' index " << 4 * k + 2 << " with lines lw 3 lc rgb '#1f77b4' title " << (k == 0 ? "'estimated line of action'" : "''") << ", "
+        << "'' index " << 4 * k + 3 << " with points pt 9 ps 2 lc rgb '#2ca02c' title " << (k == 0 ? "'estimated surface point'" : "''") << "\n";
+    }
+    s << "unset multiplot\n";
+    write_script(dir / "robot3d.gp", s.str());
+    run_gnuplot(dir / "robot3d.gp");
+    pngs.push_back(dir / "robot3d.png");
+  }
+  return pngs;
+}
+
+}  // namespace
+
+double origin_jacobian_condition(const Model& model, const Data& data, int body) {
+  if (body <= 0) return kNaN;
+  Matrix6X J(6, model.nq());
+  point_jacobian(model, data, body, data.X_WB[static_cast<std::size_t>(body)].translation, J);
+  // Columns 1..l (Remark 1: the others are zero for a chain).
+  Eigen::JacobiSVD<MatrixX> svd(J.leftCols(body));
+  const auto& sv = svd.singularValues();
+  const double smin = sv[sv.size() - 1];
+  return smin > 0.0 ? sv[0] / smin : std::numeric_limits<double>::infinity();
+}
+
+ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
+                        const EstimatorOptions& estimator_options, const ReplayOptions& o) {
+  LogReader reader(o.log, model);
+  const LogLayout& layout = reader.layout();
+  if (o.warn_ignored_columns && !reader.ignored_columns().empty()) {
+    std::string list;
+    for (const auto& c : reader.ignored_columns()) list += (list.empty() ? "" : ", ") + c;
+    std::cerr << "extwrench: note: " << reader.name() << ": ignoring columns not in the log format: " << list << "\n";
+  }
+  const SensorType sensor = estimator_options.sensor.type;
+  if (sensor == SensorType::kForceTorque && !(layout.force && layout.moment)) {
+    throw Error(reader.name() + ":1: the configuration's sensor.type is 'ft' but the log has no " +
+                (layout.force ? "ms_x, ms_y, ms_z" : "fs_x..fs_z, ms_x..ms_z") + " columns");
+  }
+  if (sensor == SensorType::kForce && !layout.force) {
+    throw Error(reader.name() + ":1: the configuration's sensor.type is 'force' but the log has no fs_x, fs_y, fs_z columns");
+  }
+  std::filesystem::create_directories(o.out_dir);
+  auto estimator = std::make_unique<ContactEstimator>(model, geometry, estimator_options);
+  const int n = model.nq();
+  EstimatesWriter writer(o.out_dir / "estimates.csv", n);
+
+  std::vector<ReplayWindow> windows = o.windows;
+  if (windows.empty()) windows.push_back({"whole_log", "every sample of the log", sim::MetricsWindow{}});
+  std::vector<sim::MetricsAccumulator> accumulators;
+  for (const auto& w : windows) accumulators.emplace_back(w.window);
+
+  Decimator dec(kQ + n, o.plot_points);
+  std::vector<double> plot_row(static_cast<std::size_t>(kQ + n));
+  Data plot_data(model);
+
+  Progress progress(o.progress, title_of(o));
+  ReplayResult result;
+  result.has_truth = layout.truth;
+  sim::Sample s;
+  bool started = false;
+  ContactEstimate first;
+  double t_begin = kNaN, t_end = kNaN;
+  while (reader.next(s)) {
+    const ContactEstimate* e = nullptr;
+    if (!started) {
+      const Status st = estimator->reset(s.t, s.q, s.dq, s.tau);
+      first = ContactEstimate{};
+      first.t = s.t;
+      first.residual = VectorX::Zero(n);
+      first.status = st;
+      started = st.ok();
+      e = &first;
+    } else {
+      const Status st = sensor == SensorType::kNone ? estimator->update(s.t, s.q, s.dq, s.tau)
+                                                   : estimator->update(s.t, s.q, s.dq, s.tau, s.sensor);
+      (void)st;  // reported in the status column
+      e = &estimator->result();
+    }
+    writer.write(*e);
+    if (std::isnan(t_begin)) t_begin = s.t;
+    t_end = s.t;
+    ++result.rows;
+    if (layout.truth) {
+      const sim::TruthSample truth = truth_of(s);
+      const sim::EstimateSample est = estimate_of(*e);
+      for (auto& acc : accumulators) acc.add(s.t, truth, est);
+    }
+    if (o.figures) {
+      if (dec.wants_next()) {
+        double* r = plot_row.data();
+        r[kT] = s.t;
+        r[kContact] = e->contact ? 1.0 : 0.0;
+        for (int k = 0; k < 3; ++k) {
+          r[kF + k] = e->contact ? e->force_W[k] : kNaN;
+          r[kL + k] = e->contact ? e->line_point_W[k] : kNaN;
+          r[kDir + k] = e->contact ? e->line_direction_W[k] : kNaN;
+          r[kP + k] = e->contact ? e->point_W[k] : kNaN;
+          const bool touched = layout.truth && s.truth.body >= 0;
+          r[kFt + k] = layout.truth ? (touched ? s.truth.force[k] : 0.0) : kNaN;
+          r[kPt + k] = touched ? s.truth.point[k] : kNaN;
+        }
+        r[kCond] = e->condition_number;
+        r[kTrueContact] = layout.truth && s.truth.body >= 0 ? 1.0 : 0.0;
+        r[kCondTrue] = kNaN;
+        if (layout.truth && s.truth.body > 0) {
+          forward_kinematics(model, plot_data, s.q);
+          r[kCondTrue] = origin_jacobian_condition(model, plot_data, s.truth.body);
+        }
+        r[kErrF] = kNaN;
+        if (layout.truth) {
+          const Vector3 f_true = s.truth.body >= 0 ? s.truth.force : Vector3::Zero();
+          const Vector3 f_est = e->contact && e->has(EstimateFlag::kForce) ? e->force_W : Vector3::Zero();
+          r[kErrF] = (f_est - f_true).norm();
+        }
+        for (int i = 0; i < n; ++i) r[kQ + i] = s.q[i];
+        dec.push(r);
+      } else {
+        dec.skip();
+      }
+    }
+    progress.update(result.rows, s.t);
+  }
+  progress.done();
+  writer.close();
+  if (result.rows == 0) throw Error(reader.name() + ": the log has a header but no rows");
+
+  MetricsReport& report = result.report;
+  report.scheme = title_of(o);
+  report.log = o.log.string();
+  report.config = o.config_label;
+  report.rows = result.rows;
+  report.t_begin = t_begin;
+  report.t_end = t_end;
+  report.surface_metrics = o.surface_metrics;
+  if (layout.truth) {
+    for (std::size_t i = 0; i < windows.size(); ++i) {
+      report.windows.push_back({windows[i].name, windows[i].description, accumulators[i].result()});
+    }
+    write_metrics_json(o.out_dir / "metrics.json", report);
+  }
+  if (o.figures) result.figures = make_figures(model, dec, o, layout.truth);
+  return result;
+}
+
+}  // namespace extwrench
