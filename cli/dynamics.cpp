@@ -17,6 +17,7 @@ namespace {
 struct DynamicsOptions {
   std::filesystem::path robot;
   std::string sensor_pose;
+  bool sensor_pose_given = false;  // an empty --sensor-pose "" is an error, not the default
   std::string in;
   std::string out;
   std::vector<std::filesystem::path> package_path;
@@ -41,7 +42,7 @@ std::vector<std::string> output_columns(int n) {
 void run_dynamics(const DynamicsOptions& opt) {
   // Check the command line before any file is touched: a usage error is reported first.
   std::optional<Pose> given_pose;
-  if (!opt.sensor_pose.empty()) given_pose = parse_pose(opt.sensor_pose, "--sensor-pose");
+  if (opt.sensor_pose_given) given_pose = parse_pose(opt.sensor_pose, "--sensor-pose");
 
   const RobotDescription robot = load_robot_file(opt.robot, opt.package_path);
   const Model& model = robot.model;
@@ -129,7 +130,7 @@ void register_dynamics(CLI::App& app) {
                   "'-' writes to stdout")
       ->required()
       ->type_name("OUT.csv");
-  sub->add_option("--sensor-pose", opt->sensor_pose,
+  CLI::Option* pose_option = sub->add_option("--sensor-pose", opt->sensor_pose,
                   "Pose of the base sensor in the root frame, \"x y z roll pitch yaw\" (m, rad, URDF "
                   "rpy). Default: the model's frame 'sensor', else the root link's origin, aligned")
       ->type_name("\"X Y Z R P Y\"");
@@ -140,7 +141,10 @@ void register_dynamics(CLI::App& app) {
       "form that reads back to the same double.\n\n"
       "Example:\n"
       "  extwrench dynamics --robot models/paper_arm.yaml --in states.csv --out predicted.csv");
-  sub->callback([opt] { run_dynamics(*opt); });
+  sub->callback([opt, pose_option] {
+    opt->sensor_pose_given = pose_option->count() > 0;
+    run_dynamics(*opt);
+  });
 }
 
 }  // namespace extwrench::cli

@@ -1,0 +1,456 @@
+// The `extwrench` binary, run as a user would: help and version, `info` checked against the
+// URDF read by the test itself, `dynamics` checked against the library called directly, and
+// malformed inputs and command lines with their messages and exit codes.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "extwrench/dynamics/data.hpp"
+#include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/io/csv.hpp"
+#include "extwrench/io/robot_loader.hpp"
+#include "support/random.hpp"
+
+namespace extwrench {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kExitInputError = 1;
+constexpr int kExitUsageError = 2;
+constexpr int kStates = 50;  // rows of the dynamics round trip (each a full CLI row)
+
+const fs::path kModels = fs::path(EXTWRENCH_SOURCE_DIR) / "models";
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+::testing::AssertionResult contains(const std::string& text, const std::string& needle) {
+  if (text.find(needle) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << needle << "'";
+}
+
+struct RunResult {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+/// A scratch directory per test, removed afterwards.
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() / ("extwrench_cli_" + std::string(info->name()) + "_" +
+                                        std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  /// Runs the binary with `args` (already shell-quoted where needed), capturing both streams.
+  RunResult run(const std::string& args) const {
+    const fs::path out = dir_ / "stdout.txt";
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string command = std::string("'") + EXTWRENCH_CLI + "' " + args + " >'" + out.string() +
+                                "' 2>'" + err.string() + "' </dev/null";
+    const int status = std::system(command.c_str());
+    RunResult r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = read_text(out);
+    r.err = read_text(err);
+    return r;
+  }
+
+  fs::path path(const std::string& name) const { return dir_ / name; }
+  std::string quoted(const std::string& name) const { return "'" + path(name).string() + "'"; }
+
+  fs::path dir_;
+};
+
+// ---- help and version --------------------------------------------------------------------
+
+TEST_F(Cli, HelpListsTheCommandsAndExamples) {
+  const RunResult r = run("--help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_TRUE(contains(r.out, "info"));
+  EXPECT_TRUE(contains(r.out, "dynamics"));
+  EXPECT_TRUE(contains(r.out, "Examples:"));
+  EXPECT_TRUE(contains(r.out, "extwrench info models/paper_arm.urdf"));
+  EXPECT_TRUE(contains(r.out, "docs/cli.md"));
+}
+
+TEST_F(Cli, EachCommandHasItsOwnHelp) {
+  const RunResult d = run("dynamics --help");
+  EXPECT_EQ(d.code, 0);
+  for (const char* option : {"--robot", "--in", "--out", "--sensor-pose", "--package-path"}) {
+    EXPECT_TRUE(contains(d.out, option));
+  }
+  EXPECT_TRUE(contains(d.out, "fs_x fs_y fs_z"));
+  const RunResult i = run("info --help");
+  EXPECT_EQ(i.code, 0);
+  EXPECT_TRUE(contains(i.out, "ROBOT"));
+}
+
+TEST_F(Cli, VersionIsTheOneInCMakeLists) {
+  // The version, read from the project's CMakeLists.txt by the test, not by the build.
+  const std::string cmake = read_text(fs::path(EXTWRENCH_SOURCE_DIR) / "CMakeLists.txt");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(cmake, m, std::regex(R"(project\(extwrench\s+VERSION\s+([0-9.]+))")));
+  const RunResult r = run("--version");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_EQ(r.out, "extwrench " + m[1].str() + "\n");
+}
+
+TEST_F(Cli, NoArgumentsPrintsTheHelpAndFails) {
+  const RunResult r = run("");
+  EXPECT_EQ(r.code, kExitUsageError);
+  EXPECT_TRUE(contains(r.out, "Subcommands:"));
+}
+
+TEST_F(Cli, UnknownCommandsAndOptionsAreUsageErrors) {
+  EXPECT_EQ(run("frobnicate").code, kExitUsageError);
+  const RunResult r = run("info --no-such-option " + kModels.string() + "/paper_arm.urdf");
+  EXPECT_EQ(r.code, kExitUsageError);
+  EXPECT_TRUE(contains(r.err, "--no-such-option"));
+}
+
+// ---- info --------------------------------------------------------------------------------
+
+/// Link names and masses read from the URDF text by the test (independent of our parser).
+struct UrdfFacts {
+  std::vector<std::string> links;
+  double total_mass = 0.0;
+  int collisions = 0;
+};
+
+UrdfFacts read_urdf_facts(const fs::path& urdf) {
+  const std::string text = read_text(urdf);
+  UrdfFacts facts;
+  const std::regex link(R"re(<link\s+name\s*=\s*"([^"]+)")re");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), link); it != std::sregex_iterator(); ++it) {
+    facts.links.push_back((*it)[1]);
+  }
+  const std::regex mass(R"re(<mass\s+value\s*=\s*"([^"]+)")re");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), mass); it != std::sregex_iterator(); ++it) {
+    facts.total_mass += std::stod((*it)[1]);
+  }
+  const std::regex collision(R"(<collision[\s>])");
+  facts.collisions = static_cast<int>(
+      std::distance(std::sregex_iterator(text.begin(), text.end(), collision), std::sregex_iterator()));
+  return facts;
+}
+
+double printed_total_mass(const std::string& out) {
+  std::smatch m;
+  if (!std::regex_search(out, m, std::regex(R"(total mass: ([-+0-9.eE]+) kg)"))) return -1.0;
+  return std::stod(m[1]);
+}
+
+TEST_F(Cli, InfoOnThePaperArmListsItsLinksAndTotalMass) {
+  const fs::path urdf = kModels / "paper_arm.urdf";
+  ASSERT_TRUE(fs::exists(urdf));
+  const UrdfFacts facts = read_urdf_facts(urdf);
+  ASSERT_GE(facts.links.size(), 8u);  // link 0 .. link 7 at least
+
+  const RunResult r = run("info '" + urdf.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const std::string& link : facts.links) EXPECT_TRUE(contains(r.out, "  " + link + "  ")) << link;
+  EXPECT_TRUE(contains(r.out, "joints: 7, serial chain"));
+  EXPECT_NEAR(printed_total_mass(r.out), facts.total_mass, 1e-9 * facts.total_mass);
+  // SPEC 5: link 0 (2.0 kg), five links of 2.7 kg, 1.7 kg and 0.3 kg.
+  EXPECT_NEAR(printed_total_mass(r.out), 2.0 + 5 * 2.7 + 1.7 + 0.3, 1e-9);
+  for (int i = 1; i <= 7; ++i) EXPECT_TRUE(contains(r.out, "  q" + std::to_string(i) + "  ")) << i;
+  EXPECT_TRUE(contains(r.out, "Base sensor pose"));
+
+  // One printed line per <collision> element.
+  const auto start = r.out.find("Collision shapes");
+  ASSERT_NE(start, std::string::npos);
+  const std::string shapes = r.out.substr(start);
+  const int lines = static_cast<int>(std::count(shapes.begin(), shapes.end(), '\n')) - 1;
+  EXPECT_EQ(lines, facts.collisions);
+}
+
+TEST_F(Cli, InfoOnTheDhTableGivesTheSameMassAsTheUrdf) {
+  const RunResult urdf = run("info '" + (kModels / "paper_arm.urdf").string() + "'");
+  const RunResult yaml = run("info '" + (kModels / "paper_arm.yaml").string() + "'");
+  ASSERT_EQ(urdf.code, 0) << urdf.err;
+  ASSERT_EQ(yaml.code, 0) << yaml.err;
+  EXPECT_NEAR(printed_total_mass(yaml.out), printed_total_mass(urdf.out), 1e-9);
+  EXPECT_TRUE(contains(yaml.out, "joints: 7, serial chain"));
+}
+
+TEST_F(Cli, InfoPrintsTheDefaultSensorPoseOfAModelWithoutSensorFrame) {
+  write_text(path("one.urdf"), R"(<robot name="one">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><mass value="0.5"/><origin xyz="0.1 0 0"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><sphere radius="0.05"/></geometry></collision></link>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/><dynamics damping="0.3" friction="0.2"/></joint>
+</robot>)");
+  const RunResult r = run("info " + quoted("one.urdf"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "the root link's origin ('base')"));
+  EXPECT_TRUE(contains(r.out, "no position limits"));
+  EXPECT_TRUE(contains(r.out, "damping 0.3"));
+  EXPECT_TRUE(contains(r.out, "friction 0.2"));
+  EXPECT_TRUE(contains(r.out, "arm: sphere radius 0.05"));
+  EXPECT_NEAR(printed_total_mass(r.out), 1.5, 1e-12);
+}
+
+TEST_F(Cli, InfoReportsAMissingOrMalformedRobotFileAsAnInputError) {
+  const RunResult missing = run("info " + quoted("nope.urdf"));
+  EXPECT_EQ(missing.code, kExitInputError);
+  EXPECT_TRUE(contains(missing.err, "nope.urdf: no such robot file"));
+
+  write_text(path("bad.urdf"), "<robot name=\"bad\">\n  <link name=\"a\">\n    <inertial><mass value=\"abc\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>\n  </link>\n</robot>\n");
+  const RunResult bad = run("info " + quoted("bad.urdf"));
+  EXPECT_EQ(bad.code, kExitInputError);
+  EXPECT_TRUE(contains(bad.err, "bad.urdf:3"));
+  EXPECT_TRUE(contains(bad.err, "mass"));
+  EXPECT_TRUE(bad.out.empty());
+
+  EXPECT_EQ(run("info").code, kExitUsageError);  // ROBOT missing
+}
+
+// ---- dynamics: round trip against the library --------------------------------------------
+
+struct States {
+  std::vector<double> t;
+  std::vector<VectorX> q, dq, ddq;
+};
+
+States random_states(int n, int count, unsigned seed) {
+  test::SeededRng rng(seed);
+  States s;
+  for (int k = 0; k < count; ++k) {
+    s.t.push_back(0.001 * k);
+    s.q.push_back(rng.uniform_vector(n, -2.5, 2.5));
+    s.dq.push_back(rng.uniform_vector(n, -2.0, 2.0));
+    s.ddq.push_back(rng.uniform_vector(n, -5.0, 5.0));
+  }
+  return s;
+}
+
+/// Writes the states with columns in a scrambled order plus two extra columns.
+void write_states(const fs::path& file, const States& s, int n) {
+  std::vector<std::string> header{"note", "ddq1"};
+  for (int i = n; i >= 1; --i) header.push_back("q" + std::to_string(i));
+  header.push_back("t");
+  for (int i = 1; i <= n; ++i) header.push_back("dq" + std::to_string(i));
+  for (int i = 2; i <= n; ++i) header.push_back("ddq" + std::to_string(i));
+  header.push_back("temperature");
+  CsvWriter w(file, header);
+  for (std::size_t k = 0; k < s.t.size(); ++k) {
+    w.add("row, " + std::to_string(k)).add(s.ddq[k][0]);
+    for (int i = n - 1; i >= 0; --i) w.add(s.q[k][i]);
+    w.add(s.t[k]);
+    for (int i = 0; i < n; ++i) w.add(s.dq[k][i]);
+    for (int i = 1; i < n; ++i) w.add(s.ddq[k][i]);
+    w.add(21.5);
+    w.end_row();
+  }
+  w.close();
+}
+
+/// Compares the CLI's output with rnea + sensor_reading called here on the same states. The
+/// doubles must match to the bit: same code, same inputs, round-trip formatting both ways.
+void expect_output_matches_library(const fs::path& out_csv, const RobotDescription& robot, const States& s,
+                                   const Pose& X_WS) {
+  const Model& model = robot.model;
+  const int n = model.nq();
+  Data data(model);
+  CsvReader reader(out_csv);
+  std::vector<std::string> expected_header{"t"};
+  for (int i = 1; i <= n; ++i) expected_header.push_back("tau" + std::to_string(i));
+  for (const char* c : {"fs_x", "fs_y", "fs_z", "ms_x", "ms_y", "ms_z"}) expected_header.emplace_back(c);
+  ASSERT_EQ(reader.header(), expected_header);
+  for (std::size_t k = 0; k < s.t.size(); ++k) {
+    ASSERT_TRUE(reader.next_row()) << "row " << k;
+    const VectorX tau = rnea(model, data, s.q[k], s.dq[k], s.ddq[k]);
+    const Vector6 reading = sensor_reading(data, X_WS);
+    EXPECT_EQ(reader.number(0), s.t[k]);
+    for (int i = 0; i < n; ++i) EXPECT_EQ(reader.number(1 + i), tau[i]) << "row " << k << " tau" << i + 1;
+    for (int j = 0; j < 6; ++j) EXPECT_EQ(reader.number(1 + n + j), reading[j]) << "row " << k << " reading " << j;
+  }
+  EXPECT_FALSE(reader.next_row());
+}
+
+TEST_F(Cli, DynamicsMatchesTheLibraryAtTheModelsSensorFrame) {
+  const fs::path urdf = kModels / "paper_arm.urdf";
+  const RobotDescription robot = load_robot(urdf);
+  const int n = robot.model.nq();
+  const States s = random_states(n, kStates, 11);
+  write_states(path("states.csv"), s, n);
+
+  const RunResult r = run("dynamics --robot '" + urdf.string() + "' --in " + quoted("states.csv") +
+                          " --out " + quoted("out.csv"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  // Extra columns are named once on stderr.
+  EXPECT_TRUE(contains(r.err, "ignoring column(s) note, temperature"));
+  EXPECT_EQ(r.err.find("ignoring"), r.err.rfind("ignoring"));
+
+  // Default pose: the model's "sensor" frame (on link 0), computed here from the model.
+  Pose X_WS;
+  if (const auto f = robot.model.find_frame("sensor")) {
+    Data data(robot.model);
+    forward_kinematics(robot.model, data, VectorX::Zero(n));
+    X_WS = frame_pose(robot.model, data, *f);
+  }
+  expect_output_matches_library(path("out.csv"), robot, s, X_WS);
+}
+
+TEST_F(Cli, DynamicsUsesTheGivenSensorPoseWithUrdfRollPitchYaw) {
+  const fs::path yaml = kModels / "paper_arm.yaml";
+  const RobotDescription robot = load_robot(yaml);
+  const int n = robot.model.nq();
+  const States s = random_states(n, kStates, 12);
+  write_states(path("states.csv"), s, n);
+
+  const RunResult r = run("dynamics --robot '" + yaml.string() + "' --sensor-pose '0.1, -0.2 0.05 0.3 -0.4 2.5' --in " +
+                          quoted("states.csv") + " --out " + quoted("out.csv"));
+  ASSERT_EQ(r.code, 0) << r.err;
+  // rpy as in URDF: R = Rz(yaw) Ry(pitch) Rx(roll), built here from angle-axis products.
+  Pose X_WS;
+  X_WS.translation = Vector3(0.1, -0.2, 0.05);
+  X_WS.rotation = (Eigen::AngleAxisd(2.5, Vector3::UnitZ()) * Eigen::AngleAxisd(-0.4, Vector3::UnitY()) *
+                   Eigen::AngleAxisd(0.3, Vector3::UnitX()))
+                      .toRotationMatrix();
+  expect_output_matches_library(path("out.csv"), robot, s, X_WS);
+}
+
+TEST_F(Cli, DynamicsOfAStaticArmReadsItsWeight) {
+  // Independent of RNEA: at rest the sensor (world-aligned by default) carries the weight.
+  const fs::path urdf = kModels / "paper_arm.urdf";
+  const RobotDescription robot = load_robot(urdf);
+  const int n = robot.model.nq();
+  States s;
+  s.t = {0.0};
+  s.q = {VectorX::LinSpaced(n, -1.0, 1.0)};
+  s.dq = {VectorX::Zero(n)};
+  s.ddq = {VectorX::Zero(n)};
+  write_states(path("static.csv"), s, n);
+  const RunResult r = run("dynamics --robot '" + urdf.string() + "' --in " + quoted("static.csv") + " --out -");
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::istringstream in(r.out);
+  CsvReader reader(in, "stdout");
+  ASSERT_TRUE(reader.next_row());
+  const double weight = read_urdf_facts(urdf).total_mass * 9.81;
+  EXPECT_NEAR(reader.number(reader.column("fs_x")), 0.0, 1e-9);
+  EXPECT_NEAR(reader.number(reader.column("fs_y")), 0.0, 1e-9);
+  EXPECT_NEAR(reader.number(reader.column("fs_z")), -weight, 1e-9 * weight);
+}
+
+// ---- dynamics: malformed inputs ----------------------------------------------------------
+
+/// Header and one valid row for the 7-joint paper arm: t, q1..q7, dq1..dq7, ddq1..ddq7.
+std::string header7() {
+  std::string h = "t";
+  for (const char* p : {"q", "dq", "ddq"}) {
+    for (int i = 1; i <= 7; ++i) h += std::string(",") + p + std::to_string(i);
+  }
+  return h;
+}
+std::string row7(const std::string& t = "0") {
+  std::string r = t;
+  for (int k = 0; k < 21; ++k) r += ",0.1";
+  return r;
+}
+
+struct BadInput {
+  const char* what;
+  std::string text;
+  std::string expected;
+};
+
+TEST_F(Cli, DynamicsReportsMalformedStatesWithFileLineAndColumn) {
+  const std::string h = header7();
+  std::string no_ddq7 = h.substr(0, h.rfind(",ddq7"));
+  std::string row_q3_bad = row7();
+  row_q3_bad.replace(row_q3_bad.find("0.1,0.1,0.1"), 11, "0.1,0.1,1.2.3");  // q3 = column 4
+  const std::vector<BadInput> cases = {
+      {"missing columns", "t,q1\n0,1\n",
+       "bad.csv:1: missing column(s) q2, q3, q4, q5, q6, q7, dq1, dq2, dq3, dq4, dq5, dq6, dq7, ddq1, ddq2, ddq3, ddq4, ddq5, ddq6, ddq7 (the robot has 7 joints"},
+      {"one missing column", no_ddq7 + "\n" + row7() + "\n", "bad.csv:1: missing column(s) ddq7 (the robot has 7 joints"},
+      {"bad number", h + "\n" + row7() + "\n" + row_q3_bad + "\n", "bad.csv:3: column 4 'q3': expected a number, got '1.2.3'"},
+      {"letters in t", h + "\n" + row7("abc") + "\n", "bad.csv:2: column 1 't': expected a number, got 'abc'"},
+      {"empty cell", h + "\n" + row7("") + "\n", "bad.csv:2: column 1 't': empty cell, expected a number"},
+      {"nan", h + "\n" + row7() + "\n" + row7("nan") + "\n", "bad.csv:3: column 1 't': expected a finite number, got 'nan'"},
+      {"short row", h + "\n" + row7() + "\n0,1,2\n", "bad.csv:3: expected 22 cells as in the header, got 3"},
+      {"long row", h + "\n" + row7() + ",5\n", "bad.csv:2: expected 22 cells as in the header, got 23"},
+      {"unterminated quote", h + "\n\"0" + row7().substr(1) + "\n", "bad.csv:2: column 1: unterminated quoted cell"},
+      {"crlf and blank lines counted", h + "\r\n" + row7() + "\r\n\r\n" + row7("0.1x") + "\r\n",
+       "bad.csv:4: column 1 't': expected a number, got '0.1x'"},
+      {"duplicate column", h + ",q1\n", "bad.csv:1: column 23 'q1' appears twice in the header (also column 2)"},
+      {"empty file", "", "bad.csv: empty file: expected a header row"},
+      {"overflow", h + "\n" + row7("1e400") + "\n", "bad.csv:2: column 1 't': number out of the range of a double: '1e400'"},
+  };
+  const std::string robot = "'" + (kModels / "paper_arm.urdf").string() + "'";
+  for (const BadInput& c : cases) {
+    SCOPED_TRACE(c.what);
+    write_text(path("bad.csv"), c.text);
+    const RunResult r = run("dynamics --robot " + robot + " --in " + quoted("bad.csv") + " --out " + quoted("out.csv"));
+    EXPECT_EQ(r.code, kExitInputError);
+    EXPECT_TRUE(contains(r.err, c.expected));
+    EXPECT_TRUE(contains(r.err, "extwrench: error: "));
+    EXPECT_FALSE(fs::exists(path("out.csv"))) << "no half-written output may remain";
+  }
+  EXPECT_GE(cases.size(), 8u);
+}
+
+TEST_F(Cli, DynamicsReportsAMissingStatesFile) {
+  const RunResult r = run("dynamics --robot '" + (kModels / "paper_arm.urdf").string() + "' --in " +
+                          quoted("none.csv") + " --out " + quoted("out.csv"));
+  EXPECT_EQ(r.code, kExitInputError);
+  EXPECT_TRUE(contains(r.err, "none.csv: cannot open the file for reading"));
+}
+
+TEST_F(Cli, DynamicsRejectsAMalformedSensorPoseAsAUsageError) {
+  write_text(path("states.csv"), header7() + "\n" + row7() + "\n");
+  const std::string base = "dynamics --robot '" + (kModels / "paper_arm.urdf").string() + "' --in " +
+                           quoted("states.csv") + " --out " + quoted("out.csv") + " --sensor-pose ";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"'1 2 3'", "--sensor-pose: 3 number(s) in '1 2 3'"},
+      {"'0 0 0 0 0 0 0'", "--sensor-pose: more than six numbers"},
+      {"'0 0 0 0 0 x'", "--sensor-pose: 'x' is not a finite number"},
+      {"'0 0 0 0 0 nan'", "--sensor-pose: 'nan' is not a finite number"},
+      {"''", "--sensor-pose: 0 number(s)"},
+  };
+  for (const auto& [pose, expected] : cases) {
+    SCOPED_TRACE(pose);
+    const RunResult r = run(base + pose);
+    EXPECT_EQ(r.code, kExitUsageError);
+    EXPECT_TRUE(contains(r.err, expected));
+    EXPECT_TRUE(contains(r.err, "x y z roll pitch yaw"));
+    EXPECT_FALSE(fs::exists(path("out.csv")));
+  }
+}
+
+TEST_F(Cli, DynamicsWithoutRequiredOptionsIsAUsageError) {
+  const RunResult r = run("dynamics --robot x.urdf --in y.csv");
+  EXPECT_EQ(r.code, kExitUsageError);
+  EXPECT_TRUE(contains(r.err, "--out is required"));
+}
+
+}  // namespace
+}  // namespace extwrench
