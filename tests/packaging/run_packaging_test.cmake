@@ -1,0 +1,59 @@
+# The packaging test (ctest runs it with cmake -P): install the build tree into a temporary
+# prefix, configure and build tests/packaging/consumer against it with find_package(extwrench),
+# run the consumers, and check the installed CLI and model files.
+#
+# Inputs: BUILD_DIR, CONSUMER_DIR, WORK_DIR, CXX_COMPILER, SANITIZE (ON when the build uses
+# the sanitizers: the consumer must then link their runtimes too), HAVE_CLI (1 when the
+# extwrench binary is built).
+foreach(var BUILD_DIR CONSUMER_DIR WORK_DIR CXX_COMPILER)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "run_packaging_test.cmake: ${var} is not set")
+  endif()
+endforeach()
+
+set(prefix ${WORK_DIR}/prefix)
+set(consumer_build ${WORK_DIR}/consumer-build)
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${WORK_DIR})
+
+function(run_step what)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "packaging test: ${what} failed (${rc}):\n${out}\n${err}")
+  endif()
+  message(STATUS "${what}: ok\n${out}")
+endfunction()
+
+run_step("install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+
+set(expected include/extwrench/dynamics/rnea.hpp include/extwrench/io/csv.hpp
+    share/extwrench/models/paper_arm.urdf share/extwrench/models/paper_arm.yaml)
+if(HAVE_CLI)
+  list(APPEND expected bin/extwrench)
+endif()
+foreach(f ${expected})
+  if(NOT EXISTS ${prefix}/${f})
+    message(FATAL_ERROR "packaging test: ${f} is not installed")
+  endif()
+endforeach()
+file(GLOB config ${prefix}/lib*/cmake/extwrench/extwrenchConfig.cmake)
+if(NOT config)
+  message(FATAL_ERROR "packaging test: no extwrenchConfig.cmake under ${prefix}/lib*/cmake/extwrench")
+endif()
+
+set(flags "")
+if(SANITIZE)
+  set(flags -DCMAKE_CXX_FLAGS=-fsanitize=address,undefined
+            -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=address,undefined)
+endif()
+run_step("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${consumer_build}
+         -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+         -DCMAKE_BUILD_TYPE=Release ${flags})
+run_step("build the consumer" ${CMAKE_COMMAND} --build ${consumer_build})
+run_step("core-only consumer" ${consumer_build}/consumer_core)
+run_step("io consumer on the installed URDF" ${consumer_build}/consumer_io ${prefix}/share/extwrench/models/paper_arm.urdf)
+run_step("io consumer on the installed DH table" ${consumer_build}/consumer_io ${prefix}/share/extwrench/models/paper_arm.yaml)
+if(HAVE_CLI)
+  run_step("installed CLI" ${prefix}/bin/extwrench info ${prefix}/share/extwrench/models/paper_arm.yaml)
+endif()
+file(REMOVE_RECURSE ${WORK_DIR})
