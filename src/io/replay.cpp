@@ -79,6 +79,16 @@ class Progress {
 
 std::string title_of(const ReplayOptions& o) { return o.name.empty() ? std::string("estimate") : o.name; }
 
+// Text for gnuplot's enhanced mode: '_' and '^' would start sub- and superscripts.
+std::string enhanced(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '_' || c == '^' || c == '@' || c == '&' || c == '~' || c == '{' || c == '}') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
 void write_script(const std::filesystem::path& path, const std::string& text) {
   std::ofstream out(path);
   if (!out) throw Error(path.string() + ": cannot create the file");
@@ -88,7 +98,7 @@ void write_script(const std::filesystem::path& path, const std::string& text) {
 // ---- figures ------------------------------------------------------------------------------
 
 std::vector<std::filesystem::path> make_figures(const Model& model, const Decimator& dec,
-                                                const ReplayOptions& o, bool truth) {
+                                                const ReplayOptions& o, bool truth, const Vector3& p_WS) {
   std::vector<std::filesystem::path> pngs;
   const std::filesystem::path dir = o.out_dir;
   const std::filesystem::path data = dir / "plot_data.txt";
@@ -100,7 +110,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
 
   {  // Fig. 5: joint positions
     std::ostringstream s;
-    s << gnuplot_png_preamble(dir / "joints.png") << "set title " << gnuplot_quote("Joint positions — " + title_of(o))
+    s << gnuplot_png_preamble(dir / "joints.png") << "set title " << gnuplot_quote("Joint positions — " + enhanced(title_of(o)))
       << "\nset xlabel 't [s]'\nset ylabel 'q_i [rad]'\nplot ";
     for (int i = 0; i < n; ++i) {
       s << (i ? ", " : "") << d << " using 1:" << col(kQ + i) << " with lines lw 2 title 'q_" << i + 1 << "'";
@@ -114,7 +124,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
   {  // Figs. 6 / 8: estimated and true force, and the error norm
     std::ostringstream s;
     s << gnuplot_png_preamble(dir / "force.png", 1000, 1000)
-      << "set multiplot layout 4,1 title " << gnuplot_quote("External force, world frame — " + title_of(o)) << "\n"
+      << "set multiplot layout 4,1 title " << gnuplot_quote("External force, world frame — " + enhanced(title_of(o))) << "\n"
       << "set key inside right top horizontal\nset lmargin 10\n";
     for (int k = 0; k < 3; ++k) {
       s << "set ylabel 'F_" << axis[k] << " [N]'\nunset xlabel\nplot " << d << " using 1:" << col(kF + k)
@@ -138,7 +148,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     std::ostringstream s;
     s << gnuplot_png_preamble(dir / "line_point.png", 1000, 850)
       << "set multiplot layout 3,1 title "
-      << gnuplot_quote("Point of the line of action p̂ (eq. 20), world frame — " + title_of(o)) << "\n"
+      << gnuplot_quote("Point of the line of action p̂ (eq. 20), world frame — " + enhanced(title_of(o))) << "\n"
       << "set key inside right top horizontal\nset lmargin 10\n";
     for (int k = 0; k < 3; ++k) {
       s << "set ylabel 'p_" << axis[k] << " [m]'\n" << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n")
@@ -154,12 +164,12 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
   {  // Fig. 10: condition numbers
     std::ostringstream s;
     s << gnuplot_png_preamble(dir / "condition.png", 1000, 600) << "set title "
-      << gnuplot_quote("Condition number — " + title_of(o))
+      << gnuplot_quote("Condition number — " + enhanced(title_of(o)))
       << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\nset logscale y\nset key inside left top\nplot "
       << d << " using 1:" << col(kCond) << " with lines lw 2 lc rgb '#1f77b4' title 'Jacobian inverted by the estimator'";
     if (truth) {
       s << ", " << d << " using 1:" << col(kCondTrue)
-        << " with lines lw 2 dt 2 lc rgb '#d62728' title 'J of O_l, l = true contact link'";
+        << " with lines lw 2 dt 2 lc rgb '#d62728' title 'J of O_l (world frame, SI), l = true contact link'";
     }
     s << "\n";
     write_script(dir / "condition.gp", s.str());
@@ -182,6 +192,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
       VectorX q(n);
       for (int i = 0; i < n; ++i) q[i] = row[kQ + i];
       forward_kinematics(model, data, q);
+      out << p_WS.x() << " " << p_WS.y() << " " << p_WS.z() << "\n";  // the base sensor
       for (int b = 0; b < model.num_bodies(); ++b) {
         const Vector3& p = data.X_WB[b].translation;
         out << p.x() << " " << p.y() << " " << p.z() << "\n";
@@ -215,12 +226,13 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     const int cols = rows.size() > 1 ? 2 : 1;
     const int lines = static_cast<int>((rows.size() + 1) / 2);
     s << gnuplot_png_preamble(dir / "robot3d.png", 1100, 550 * std::max(1, lines))
-      << "set multiplot layout " << std::max(1, lines) << "," << cols << " title "
-      << gnuplot_quote("Robot, true contact point and estimated line of action — " + title_of(o)) << "\n"
-      << "set view 65,35\nset view equal xyz\n"
+      << "set multiplot layout " << std::max(1, lines) << "," << cols
+      << " title "
+      << gnuplot_quote("Robot, true contact point and estimated line of action — " + enhanced(title_of(o))) << "\n"
+      << "set view 62,30,1.2\nset view equal xyz\n"
       << "set xrange [" << -extent << ":" << extent << "]\nset yrange [" << -extent << ":" << extent
-      << "]\nset zrange [" << -0.35 << ":" << extent + 0.1 << "]\n"
-      << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]'\nset key at screen 1, screen 1 top right\n"
+      << "]\nset zrange [" << std::min(-0.35, p_WS.z() - 0.05) << ":" << extent + 0.1 << "]\n"
+      << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]'\nset key at screen 0.99, screen 0.995 top right samplen 2\n"
       << "set ticslevel 0\n";
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const double t = dec.row(rows[k])[kT];
@@ -228,7 +240,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
       std::snprintf(buf, sizeof buf, "t = %.2f s", t);
       s << "set title '" << buf << "'\n"
         << "splot 'robot3d.txt' index " << 4 * k << " with linespoints lw 4 pt 7 ps 1 lc rgb '#555555' title "
-        << (k == 0 ? "'links (joint frame origins)'" : "''") << ", "
+        << (k == 0 ? "'links (sensor, joint frame origins)'" : "''") << ", "
         << "'' index " << 4 * k + 1 << " with points pt 7 ps 2 lc rgb '#d62728' title " << (k == 0 ? "'true point'" : "''") << ", "
         << "'' index " << 4 * k + 2 << " with lines lw 3 lc rgb '#1f77b4' title " << (k == 0 ? "'estimated line of action'" : "''") << ", "
         << "'' index " << 4 * k + 3 << " with points pt 9 ps 2 lc rgb '#2ca02c' title " << (k == 0 ? "'estimated surface point'" : "''") << "\n";
@@ -370,7 +382,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     }
     write_metrics_json(o.out_dir / "metrics.json", report);
   }
-  if (o.figures) result.figures = make_figures(model, dec, o, layout.truth);
+  if (o.figures) result.figures = make_figures(model, dec, o, layout.truth, estimator_options.sensor.pose.translation);
   return result;
 }
 
