@@ -1,0 +1,185 @@
+// The estimator's YAML configuration (docs/config.md): every key, the defaults, relative robot
+// paths, a write/read round trip, and errors that name the file, the line and the key.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/io/estimator_config.hpp"
+
+namespace extwrench {
+namespace {
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+const std::filesystem::path kDir = std::filesystem::path(EXTWRENCH_TEST_DATA_DIR) / "config";
+
+TEST(EstimatorConfig, ReadsEveryKeyOfAFullFile) {
+  const EstimatorConfig c = load_estimator_config(kDir / "paper_ft.yaml");
+  const EstimatorOptions& o = c.options;
+  EXPECT_EQ(c.robot.model.nq(), 7);
+  EXPECT_EQ(o.sensor.type, SensorType::kForceTorque);
+  EXPECT_TRUE(o.sensor.pose.translation.isApprox(Vector3(0, 0, -0.31)));
+  EXPECT_EQ(o.sensor.tare_samples, 20);
+  EXPECT_EQ(o.contact.model, ContactModel::kPureForce);
+  EXPECT_EQ(o.observer_gain.size(), 7);
+  EXPECT_EQ(o.observer_gain[3], 120.0);
+  EXPECT_EQ(o.detection.tau_min[6], 0.3);
+  EXPECT_EQ(o.detection.f_min, 4.0);
+  EXPECT_EQ(o.detection.release_ratio, 0.6);
+  EXPECT_EQ(o.detection.min_duration, 0.004);
+  EXPECT_EQ(o.acceleration, AccelerationRoute::kResidual);
+  ASSERT_TRUE(o.friction.has_value());
+  EXPECT_EQ(o.friction->viscous, VectorX::Constant(7, 0.1));
+  EXPECT_EQ(o.friction->coulomb[5], 0.05);
+  EXPECT_EQ(o.friction->smoothing_velocity, 0.002);
+  ASSERT_TRUE(o.payload.has_value());
+  EXPECT_EQ(c.robot.model.bodies[o.payload->body].name, "link7");
+  EXPECT_EQ(o.payload->inertia.mass, 0.5);
+  EXPECT_EQ(o.payload->inertia.inertia_com(2, 2), 0.0005);
+  EXPECT_EQ(o.solver.max_condition, 2000.0);
+  EXPECT_EQ(o.solver.rank_tolerance, 1e-6);
+}
+
+TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {
+  const EstimatorConfig c = load_estimator_config(kDir / "minimal_none.yaml");
+  const EstimatorOptions d;
+  EXPECT_EQ(c.options.sensor.type, SensorType::kNone);
+  EXPECT_TRUE(c.options.sensor.pose.is_approx(Pose{}));
+  EXPECT_EQ(c.options.sensor.tare_samples, 0);
+  EXPECT_EQ(c.options.contact.model, ContactModel::kPureForce);
+  EXPECT_EQ(c.options.observer_gain, d.observer_gain);
+  EXPECT_EQ(c.options.detection.tau_min, d.detection.tau_min);
+  EXPECT_EQ(c.options.detection.f_min, d.detection.f_min);
+  EXPECT_EQ(c.options.acceleration, AccelerationRoute::kResidual);
+  EXPECT_FALSE(c.options.friction.has_value());  // the robot file's <dynamics>
+  EXPECT_FALSE(c.options.payload.has_value());
+  EXPECT_TRUE(c.robot.model.gravity.isApprox(Vector3(0, 0, -9.81)));
+}
+
+TEST(EstimatorConfig, RobotPathIsRelativeToTheConfigFileAndKnownPointLinksResolveByName) {
+  const EstimatorConfig c = load_estimator_config(kDir / "known_point_force.yaml");
+  EXPECT_TRUE(std::filesystem::equivalent(c.robot_path, std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf"));
+  EXPECT_EQ(c.options.sensor.type, SensorType::kForce);
+  EXPECT_EQ(c.options.sensor.tare_samples, 100);  // tare: true
+  EXPECT_EQ(c.options.contact.model, ContactModel::kKnownPoint);
+  EXPECT_EQ(c.robot.model.bodies[c.options.contact.link].name, "link6");
+  EXPECT_TRUE(c.options.contact.point.isApprox(Vector3(0, 0, 0.1)));
+  EXPECT_EQ(c.options.acceleration, AccelerationRoute::kDifferentiation);
+  EXPECT_EQ(c.options.differentiation_cutoff, 40.0);
+  ASSERT_TRUE(c.options.friction.has_value());
+  EXPECT_TRUE(c.options.friction->is_zero());
+}
+
+TEST(EstimatorConfig, GravityOfTheConfigOverridesTheRobotFile) {
+  const EstimatorConfig c = load_estimator_config_string(
+      "robot: ../../../models/paper_arm.urdf\ngravity: [9.81, 0, 0]\nsensor: {type: ft}\n", kDir / "wall.yaml");
+  EXPECT_TRUE(c.robot.model.gravity.isApprox(Vector3(9.81, 0, 0)));
+}
+
+TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
+  for (const char* file : {"paper_ft.yaml", "known_point_force.yaml", "minimal_none.yaml"}) {
+    const EstimatorConfig a = load_estimator_config(kDir / file);
+    const std::string text = to_yaml(a, kDir);
+    const EstimatorConfig b = load_estimator_config_string(text, kDir / "written.yaml");
+    const EstimatorOptions &x = a.options, &y = b.options;
+    EXPECT_EQ(x.sensor.type, y.sensor.type) << file;
+    EXPECT_TRUE(x.sensor.pose.is_approx(y.sensor.pose, 1e-15)) << file;
+    EXPECT_EQ(x.sensor.tare_samples, y.sensor.tare_samples) << file;
+    EXPECT_EQ(x.contact.model, y.contact.model) << file;
+    EXPECT_EQ(x.contact.link, y.contact.link) << file;
+    EXPECT_EQ(x.contact.point, y.contact.point) << file;
+    EXPECT_EQ(x.observer_gain.minCoeff(), y.observer_gain.minCoeff()) << file;
+    EXPECT_EQ(x.observer_gain.maxCoeff(), y.observer_gain.maxCoeff()) << file;
+    EXPECT_EQ(x.detection.f_min, y.detection.f_min) << file;
+    EXPECT_EQ(x.detection.release_ratio, y.detection.release_ratio) << file;
+    EXPECT_EQ(x.detection.min_duration, y.detection.min_duration) << file;
+    EXPECT_EQ(x.acceleration, y.acceleration) << file;
+    EXPECT_EQ(x.differentiation_cutoff, y.differentiation_cutoff) << file;
+    EXPECT_EQ(x.friction.has_value(), y.friction.has_value()) << file;
+    EXPECT_EQ(x.payload.has_value(), y.payload.has_value()) << file;
+    EXPECT_EQ(x.solver.max_condition, y.solver.max_condition) << file;
+    EXPECT_TRUE(a.robot.model.gravity == b.robot.model.gravity) << file;
+  }
+}
+
+TEST(EstimatorConfig, MakesAWorkingEstimator) {
+  const EstimatorConfig c = load_estimator_config(kDir / "paper_ft.yaml");
+  const std::unique_ptr<ContactEstimator> est = make_estimator(c);
+  const VectorX z = VectorX::Zero(7);
+  ASSERT_TRUE(est->reset(0.0, z, z, z).ok());
+  EXPECT_TRUE(est->update(1e-3, z, z, z, Vector6::Zero()).ok());
+}
+
+struct BadConfig {
+  const char* yaml;
+  const char* line;   // ":<line>:" expected in the message
+  const char* key;    // key named in the message
+  const char* what;   // part of the explanation
+};
+
+class EstimatorConfigErrors : public ::testing::TestWithParam<BadConfig> {};
+
+TEST_P(EstimatorConfigErrors, NameTheFileTheLineAndTheKey) {
+  const BadConfig& b = GetParam();
+  const std::string yaml = std::string("robot: ../../../models/paper_arm.urdf\n") + b.yaml;
+  try {
+    (void)load_estimator_config_string(yaml, kDir / "bad.yaml");
+    FAIL() << "no error for:\n" << yaml;
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_TRUE(contains(msg, "bad.yaml")) << msg;
+    EXPECT_TRUE(contains(msg, b.line)) << msg;
+    EXPECT_TRUE(contains(msg, b.key)) << msg;
+    EXPECT_TRUE(contains(msg, b.what)) << msg;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Malformed, EstimatorConfigErrors,
+    ::testing::Values(
+        BadConfig{"sensor: {type: ft}\nsenser: 1\n", ":3:", "senser", "unknown key"},
+        BadConfig{"sensor:\n  type: ft\n  tipe: 2\n", ":4:", "sensor.tipe", "unknown key"},
+        BadConfig{"sensor: {type: laser}\n", ":2:", "sensor.type", "expected one of ft, force, none"},
+        BadConfig{"sensor: {pose: {xyz: [0, 0, 0]}}\n", ":2:", "sensor.type", "missing"},
+        BadConfig{"gravity: [0, 0]\nsensor: {type: ft}\n", ":2:", "gravity", "3 numbers"},
+        BadConfig{"sensor:\n  type: ft\n  pose: {xyz: [0, a, 0]}\n", ":4:", "sensor.pose.xyz[1]", "finite number"},
+        BadConfig{"sensor: {type: ft, tare: -3}\n", ":2:", "sensor.tare", "whole number"},
+        BadConfig{"sensor: {type: none}\nobserver:\n  gain: fast\n", ":4:", "observer.gain", "finite number"},
+        BadConfig{"sensor: {type: none}\nobserver:\n  gain: -5\n", ":4:", "observer.gain", "> 0"},
+        BadConfig{"sensor: {type: none}\ndetection:\n  tau_min: [1, 2, 3]\n", ":4:", "detection.tau_min", "7 values"},
+        BadConfig{"sensor: {type: ft}\ndetection:\n  release_ratio: 1.5\n", ":4:", "detection.release_ratio", "(0, 1]"},
+        BadConfig{"sensor: {type: ft}\ndetection:\n  min_duration: -0.1\n", ":4:", "detection.min_duration", ">= 0"},
+        BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: 0\n", ":4:", "detection.f_min", "> 0"},
+        BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n  link: link99\n", ":5:", "contact.link",
+                  "no link named 'link99'"},
+        BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n", ":4:", "contact.link", "missing"},
+        BadConfig{"sensor: {type: ft}\ncontact: {model: guess}\n", ":3:", "contact.model", "pure_force or known_point"},
+        BadConfig{"sensor: {type: ft}\nacceleration: integrate\n", ":3:", "acceleration", "residual or differentiation"},
+        BadConfig{"sensor: {type: ft}\nfriction: {viscous: [1, 2]}\n", ":3:", "friction.viscous", "7 values"},
+        BadConfig{"sensor: {type: ft}\npayload: {link: link7, mass: -1}\n", ":3:", "payload.mass", ">= 0"},
+        BadConfig{"sensor: {type: ft}\npayload: {link: link7, mass: 1, inertia: [1, 0, 0, 1, 0, -1]}\n", ":3:",
+                  "payload.inertia", "payload"},
+        BadConfig{"sensor: {type: ft}\nsolver: {max_condition: 0.5}\n", ":3:", "solver.max_condition", "> 1"},
+        BadConfig{"sensor: [ft\n", ":", "YAML", "syntax"}));
+
+TEST(EstimatorConfig, MissingRobotOrRobotFileIsAnErrorNamingTheKey) {
+  try {
+    (void)load_estimator_config_string("sensor: {type: ft}\n", kDir / "norobot.yaml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(std::string(e.what()), "norobot.yaml"));
+    EXPECT_TRUE(contains(std::string(e.what()), "robot: missing"));
+  }
+  try {
+    (void)load_estimator_config_string("robot: nowhere.urdf\nsensor: {type: ft}\n", kDir / "lost.yaml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(std::string(e.what()), "lost.yaml:1: robot: cannot load"));
+  }
+  EXPECT_THROW((void)load_estimator_config(kDir / "does_not_exist.yaml"), Error);
+}
+
+}  // namespace
+}  // namespace extwrench

@@ -1,0 +1,300 @@
+// Real-time properties of the estimator (acceptance 4 of issue 3) and its smaller contracts:
+// no allocation in any configuration, bit-identical recovery after bad inputs, bounded and
+// flagged output near singularities, tare, a line of action that misses the link.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <limits>
+
+#include "estimation/kdl_reference.hpp"
+#include "estimation/test_robots.hpp"
+#include "extwrench/core/error.hpp"
+#include "extwrench/estimation/contact_estimator.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace extwrench {
+namespace {
+
+using test::SeededRng;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Consistent samples (q, q̇, q̈, τ, reading) of the paper arm with a force on `link`, from KDL.
+struct Samples {
+  std::vector<VectorX> q, dq, tau;
+  std::vector<Vector6> reading;
+};
+
+Samples make_samples(int count, int link, unsigned seed) {
+  const Model model = test::paper_arm_model();
+  test::KdlReference kdl(model);
+  const GeometryModel geometry = test::paper_arm_capsules(model);
+  const CollisionShape& shape = geometry.shapes[geometry.body_shapes[link][0]];
+  SeededRng rng(seed);
+  Samples s;
+  VectorX q = rng.uniform_vector(7, -1, 1);
+  for (int k = 0; k < count; ++k) {
+    q += rng.uniform_vector(7, -0.01, 0.01);
+    const VectorX dq = rng.uniform_vector(7, -0.5, 0.5), ddq = rng.uniform_vector(7, -1, 1);
+    const auto [p_L, n_L] = test::random_surface_point(shape, rng);
+    const Pose X = kdl.compute_body_pose(q, link);
+    const Vector3 F = -20.0 * (X.rotation * n_L) + rng.uniform_vector3(-5, 5);
+    const auto ref = kdl.compute(q, dq, ddq, link, F, X.act(p_L), Vector3::Zero());
+    s.q.push_back(q);
+    s.dq.push_back(dq);
+    s.tau.push_back(ref.tau);
+    s.reading.push_back(test::to_sensor_frame(ref.reading_W, Pose{}));
+  }
+  return s;
+}
+
+struct Config {
+  SensorType sensor;
+  ContactModel contact;
+  AccelerationRoute route;
+};
+
+std::vector<Config> all_configs() {
+  std::vector<Config> out;
+  for (SensorType s : {SensorType::kForceTorque, SensorType::kForce, SensorType::kNone}) {
+    for (ContactModel c : {ContactModel::kPureForce, ContactModel::kKnownPoint}) {
+      for (AccelerationRoute r : {AccelerationRoute::kResidual, AccelerationRoute::kDifferentiation}) {
+        out.push_back({s, c, r});
+      }
+    }
+  }
+  return out;
+}
+
+EstimatorOptions options_for(const Config& c) {
+  EstimatorOptions o;
+  o.sensor.type = c.sensor;
+  o.contact.model = c.contact;
+  o.contact.link = 7;
+  o.contact.point = Vector3(0.0, 0.04, 0.03);
+  o.acceleration = c.route;
+  o.observer_gain = VectorX::Constant(1, 200.0);
+  o.detection.min_duration = 0.0;
+  o.detection.tau_min = VectorX::Constant(1, 0.05);
+  o.sensor.tare_samples = 5;
+  return o;
+}
+
+std::string describe(const Config& c) {
+  return std::string(to_string(c.sensor)) + "/" + std::string(to_string(c.contact)) + "/" +
+         std::string(to_string(c.route));
+}
+
+TEST(EstimatorRealTime, TenThousandUpdatesOfEveryConfigurationAllocateNothing) {
+  if (!test::allocation_counting_available()) GTEST_SKIP() << "sanitizer build";
+  const Samples s = make_samples(100, 7, 3);
+  const Model model = test::paper_arm_model();
+  for (const Config& c : all_configs()) {
+    ContactEstimator est(model, test::paper_arm_capsules(model), options_for(c));
+    ASSERT_TRUE(est.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    std::uint32_t seen = 0;
+    int failures = 0;
+    test::AllocationCounter counter;
+    for (int k = 1; k <= 10000; ++k) {
+      const int i = k % 100;
+      const Status st = c.sensor == SensorType::kNone ? est.update(k * 1e-3, s.q[i], s.dq[i], s.tau[i])
+                                                      : est.update(k * 1e-3, s.q[i], s.dq[i], s.tau[i], s.reading[i]);
+      failures += st.ok() ? 0 : 1;
+      seen |= est.result().flags;
+    }
+    const std::size_t allocations = counter.count();
+    EXPECT_EQ(allocations, 0u) << describe(c);
+    EXPECT_EQ(failures, 0) << describe(c);
+    // The paths that matter ran: contact declared, and the point or the moment estimated.
+    EXPECT_TRUE(seen & EstimateFlag::kContact) << describe(c);
+    if (c.contact == ContactModel::kPureForce) {
+      EXPECT_TRUE(seen & EstimateFlag::kLineOfAction) << describe(c);
+      EXPECT_TRUE(seen & (EstimateFlag::kSurfacePoint | EstimateFlag::kSurfaceMissed)) << describe(c);
+    } else {
+      EXPECT_TRUE(seen & EstimateFlag::kMoment) << describe(c);
+    }
+  }
+}
+
+bool same_bits(const ContactEstimate& a, const ContactEstimate& b) {
+  auto eq = [](const auto& x, const auto& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), sizeof(double) * x.size()) == 0;
+  };
+  return a.contact == b.contact && a.link == b.link && a.flags == b.flags && a.status.code == b.status.code &&
+         eq(a.force_W, b.force_W) && eq(a.moment_W, b.moment_W) && eq(a.point_W, b.point_W) &&
+         eq(a.point_L, b.point_L) && eq(a.line_point_W, b.line_point_W) &&
+         eq(a.line_direction_W, b.line_direction_W) && eq(a.residual, b.residual) &&
+         std::memcmp(&a.condition_number, &b.condition_number, sizeof(double)) == 0 &&
+         std::memcmp(&a.surface_distance, &b.surface_distance, sizeof(double)) == 0;
+}
+
+TEST(EstimatorRealTime, AfterNaNOrInfInputsTheNextGoodSampleIsBitIdenticalToACleanRun) {
+  const Samples s = make_samples(60, 6, 4);
+  const Model model = test::paper_arm_model();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const Config& c : all_configs()) {
+    const EstimatorOptions o = options_for(c);
+    ContactEstimator clean(model, test::paper_arm_capsules(model), o);
+    ContactEstimator dirty(model, test::paper_arm_capsules(model), o);
+    ASSERT_TRUE(clean.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    ASSERT_TRUE(dirty.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    for (int k = 1; k < 60; ++k) {
+      const double t = k * 1e-3;
+      if (k % 4 == 0) {
+        VectorX q = s.q[k], dq = s.dq[k], tau = s.tau[k];
+        Vector6 reading = s.reading[k];
+        q[k % 7] = kNaN;
+        Status st = dirty.update(t, q, s.dq[k], s.tau[k], s.reading[k]);
+        EXPECT_EQ(st.code, StatusCode::kNonFinite);
+        EXPECT_EQ(st.channel, Channel::kPosition);
+        EXPECT_EQ(st.index, k % 7);
+        EXPECT_TRUE(dirty.result().force_W.array().isNaN().all());
+        dq[(k + 3) % 7] = inf;
+        st = dirty.update(t, s.q[k], dq, s.tau[k], s.reading[k]);
+        EXPECT_EQ(st.channel, Channel::kVelocity);
+        tau[0] = -inf;
+        st = dirty.update(t, s.q[k], s.dq[k], tau, s.reading[k]);
+        EXPECT_EQ(st.channel, Channel::kTorque);
+        if (c.sensor != SensorType::kNone) {
+          reading[2] = kNaN;
+          st = dirty.update(t, s.q[k], s.dq[k], s.tau[k], reading);
+          EXPECT_EQ(st.channel, Channel::kBaseWrench);
+          EXPECT_EQ(st.index, 2);
+        }
+        st = dirty.update(t - 1e-3, s.q[k], s.dq[k], s.tau[k], s.reading[k]);
+        EXPECT_EQ(st.code, StatusCode::kNonIncreasingTime);
+      }
+      ASSERT_TRUE(clean.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(dirty.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(same_bits(clean.result(), dirty.result())) << describe(c) << " sample " << k;
+    }
+  }
+}
+
+// J_6 of the paper arm is singular at q4 = 0 (SPEC §4 E): approaching it, case E stays finite,
+// bounded and flagged, and exactly there it says the wrench is not observable.
+TEST(EstimatorRealTime, NearASingularityTheEstimateStaysFiniteBoundedAndFlagged) {
+  const Model model = test::paper_arm_model();
+  test::KdlReference kdl(model);
+  EstimatorOptions o;
+  o.sensor.type = SensorType::kNone;
+  o.contact.model = ContactModel::kPureForce;
+  o.detection.tau_min = VectorX::Constant(1, 1e-6);
+  o.detection.min_duration = 0.0;
+  double t = 0;
+  for (double q4 : {0.3, 1e-2, 1e-3, 1e-4, 1e-6, 1e-9, 0.0}) {
+    ContactEstimator est(model, test::paper_arm_capsules(model), o);
+    VectorX q(7);
+    q << 0.2, 0.7, -0.3, q4, 0.4, -0.6, 0.2;
+    const VectorX zero = VectorX::Zero(7);
+    const Vector3 F(5, -12, 8);
+    const Pose X = kdl.compute_body_pose(q, 6);
+    const auto ref = kdl.compute(q, zero, zero, 6, F, X.act(Vector3(0.0, 0.06, 0.0)), Vector3::Zero());
+    t += 1e-3;
+    ASSERT_TRUE(est.update_with(t, q, zero, zero, ref.tau_ext, ref.tau, Vector6::Zero()).ok());
+    const ContactEstimate& e = est.result();
+    ASSERT_TRUE(e.contact);
+    ASSERT_EQ(e.link, 6);
+    if (e.has(EstimateFlag::kForce)) {
+      EXPECT_TRUE(e.force_W.allFinite()) << "q4 = " << q4;
+      // Damped least squares never amplifies: ‖F̂‖ stays of the order of the true force.
+      EXPECT_LE(e.force_W.norm(), 2.0 * F.norm()) << "q4 = " << q4;
+    } else {
+      EXPECT_TRUE(e.has(EstimateFlag::kUnobservable)) << "q4 = " << q4;
+    }
+    if (q4 >= 0.3) {
+      EXPECT_FALSE(e.has(EstimateFlag::kIllConditioned));
+      EXPECT_LE((e.force_W - F).norm(), 1e-6 * F.norm());
+    } else if (q4 <= 1e-4) {
+      EXPECT_GT(e.condition_number, 1e3) << "q4 = " << q4;
+      EXPECT_TRUE(e.has(EstimateFlag::kIllConditioned) || e.has(EstimateFlag::kUnobservable)) << "q4 = " << q4;
+    }
+    if (q4 == 0.0) {
+      EXPECT_TRUE(e.has(EstimateFlag::kUnobservable));
+    }
+  }
+}
+
+TEST(EstimatorRealTime, TareRemovesAConstantSensorBiasEstimatedAtRest) {
+  const Model model = test::paper_arm_model();
+  test::KdlReference kdl(model);
+  EstimatorOptions o;
+  o.sensor.type = SensorType::kForceTorque;
+  o.sensor.tare_samples = 50;
+  o.contact.model = ContactModel::kKnownPoint;
+  o.contact.link = 4;
+  o.contact.point = Vector3(0.06, 0, 0);
+  o.detection.min_duration = 0.0;
+  const Vector6 bias = (Vector6() << 3.0, -2.0, 40.0, 0.5, -0.7, 0.2).finished();
+  // Robot at rest, held by τ = g(q) (so the residual stays zero), then touched.
+  VectorX q(7);
+  q << 0.1, 0.8, 0.2, -1.1, 0.3, 0.5, 0.0;
+  const VectorX zero = VectorX::Zero(7);
+  const auto free = kdl.compute(q, zero, zero, 4, Vector3::Zero(), Vector3::Zero(), Vector3::Zero());
+  ContactEstimator est(model, {}, o);
+  ASSERT_TRUE(est.reset(0.0, q, zero, free.tau).ok());
+  for (int k = 1; k <= 50; ++k) {
+    ASSERT_TRUE(est.update(k * 1e-3, q, zero, free.tau, test::to_sensor_frame(free.reading_W, Pose{}) + bias).ok());
+    EXPECT_EQ(est.result().has(EstimateFlag::kTaring), k < 50);
+    EXPECT_FALSE(est.result().contact);
+  }
+  EXPECT_LE((est.sensor_bias() - bias).norm(), 1e-9);
+  // A static contact balanced by the controller: the base sees it instantly.
+  const Pose X = kdl.compute_body_pose(q, 4);
+  const Vector3 F(8, 3, -6), M(0.3, 0.1, -0.2);
+  const auto touched = kdl.compute(q, zero, zero, 4, F, X.act(o.contact.point), M);
+  ASSERT_TRUE(est.update(0.051, q, zero, free.tau, test::to_sensor_frame(touched.reading_W, Pose{}) + bias).ok());
+  EXPECT_LE((est.result().force_W - F).norm(), 1e-6 * F.norm());
+  EXPECT_LE((est.result().moment_W - M).norm(), 1e-6);
+  EXPECT_TRUE(est.result().contact);
+}
+
+TEST(EstimatorRealTime, ALineOfActionThatMissesTheLinkReportsTheNearestSurfacePoint) {
+  const Model model = test::paper_arm_model();
+  test::KdlReference kdl(model);
+  EstimatorOptions o;
+  o.sensor.type = SensorType::kForceTorque;
+  o.detection.tau_min = VectorX::Constant(1, 1e-6);
+  o.detection.min_duration = 0.0;
+  ContactEstimator est(model, test::paper_arm_capsules(model), o);
+  VectorX q(7);
+  q << 0.2, 0.5, -0.3, 1.0, 0.4, -0.6, 0.2;
+  const VectorX zero = VectorX::Zero(7);
+  // A force along y applied at x = 0.3 m off link 5's capsule axis (radius 0.055): its line
+  // stays 0.3 m from the axis and never meets the capsule (τ_ext,5 = 3 N m isolates link 5).
+  const Pose X = kdl.compute_body_pose(q, 5);
+  const Vector3 p_W = X.act(Vector3(0.3, 0.0, 0.2));
+  const Vector3 F = X.rotation * Vector3(0, 10, 0);
+  const auto ref = kdl.compute(q, zero, zero, 5, F, p_W, Vector3::Zero());
+  ASSERT_TRUE(est.update_with(0.0, q, zero, zero, ref.tau_ext, ref.tau, test::to_sensor_frame(ref.reading_W, Pose{})).ok());
+  const ContactEstimate& e = est.result();
+  ASSERT_EQ(e.link, 5);
+  EXPECT_TRUE(e.has(EstimateFlag::kLineOfAction));
+  EXPECT_TRUE(e.has(EstimateFlag::kSurfaceMissed));
+  EXPECT_FALSE(e.has(EstimateFlag::kSurfacePoint));
+  EXPECT_NEAR(e.surface_distance, 0.3 - 0.055, 1e-6);
+  EXPECT_NEAR(e.point_L.head<2>().norm(), 0.055, 1e-6);  // on the capsule's cylinder
+}
+
+TEST(EstimatorRealTime, RejectsOptionsThatDoNotFitTheModel) {
+  const Model model = test::paper_arm_model();
+  EstimatorOptions o;
+  o.contact.model = ContactModel::kKnownPoint;
+  o.contact.link = 8;
+  EXPECT_THROW(ContactEstimator(model, {}, o), Error);
+  o.contact.link = 3;
+  o.detection.tau_min = VectorX::Ones(3);
+  EXPECT_THROW(ContactEstimator(model, {}, o), Error);
+  o.detection.tau_min = VectorX::Ones(7);
+  o.detection.release_ratio = 1.5;
+  EXPECT_THROW(ContactEstimator(model, {}, o), Error);
+  o.detection.release_ratio = 0.5;
+  EXPECT_NO_THROW(ContactEstimator(model, {}, o));
+  Model tree = test::random_model({.n = 5, .tree = true, .prismatic = false, .seed = 4});
+  if (!tree.is_serial_chain()) {
+    EXPECT_THROW(ContactEstimator(tree, {}, EstimatorOptions{}), Error);
+  }
+}
+
+}  // namespace
+}  // namespace extwrench
