@@ -22,7 +22,7 @@ double stamp(std::size_t k, const Trajectory& tr) { return static_cast<double>(k
 // same sample time, its low-pass filter off (we have none).
 void BM_ExtWrench_Kdl(benchmark::State& state) {
   const PaperArm& arm = paper_arm();
-  const Trajectory& tr = trajectory();
+  const Trajectory& tr = flange_trajectory();
   const KDL::Vector g(arm.model.gravity.x(), arm.model.gravity.y(), arm.model.gravity.z());
   KDL::ChainExternalWrenchEstimator estimator(arm.chain, g, 1.0 / tr.dt, kGain, 0.0);
   if (estimator.setInitialMomentum(tr.kq[0], tr.kdq[0]) != 0) {
@@ -44,7 +44,7 @@ BENCHMARK(BM_ExtWrench_Kdl);
 // The momentum residual (4) alone: O(n) momentum terms + the exact first-order update.
 void BM_Residual_Ours(benchmark::State& state) {
   const PaperArm& arm = paper_arm();
-  const Trajectory& tr = trajectory();
+  const Trajectory& tr = flange_trajectory();
   MomentumObserver observer(arm.model, kGain);
   if (!observer.reset(0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok()) {
     state.SkipWithError("reset failed");

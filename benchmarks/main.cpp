@@ -17,6 +17,10 @@ int main(int argc, char** argv) {
   try {
     const auto& arm = extwrench::bench::paper_arm();  // loads and cross-checks both robots
     benchmark::AddCustomContext("robot", arm.source);
+    if (const auto* panda = extwrench::bench::panda_arm(); panda != nullptr) {
+      benchmark::AddCustomContext("mesh_robot", panda->source);
+    }
+    extwrench::bench::register_contact_benchmarks();
   } catch (const std::exception& e) {
     std::cerr << "extwrench_bench: set-up failed: " << e.what() << '\n';
     return 1;

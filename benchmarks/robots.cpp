@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -211,15 +212,17 @@ StatePool make_state_pool(int n) {
   return pool;
 }
 
-Trajectory make_trajectory(const Model& model) {
+Trajectory make_trajectory(const Model& model, const ContactSpec& contact_spec) {
   Trajectory tr;
+  tr.contact = contact_spec;
   const int n = model.nq();
-  // Away from the wrist/elbow singularities (q2, q4 far from 0), so case E stays well posed.
+  // Away from the wrist/elbow singularities (q2, q4 far from 0), so case E stays well posed;
+  // inside the Panda's joint ranges too.
   const double q0[7] = {0.3, 0.8, 0.2, -1.2, 0.4, 0.9, 0.1};
   const double amp[7] = {0.4, 0.25, 0.5, 0.25, 0.6, 0.3, 0.8};
   const double freq[7] = {0.5, 1.0, 0.5, 1.0, 1.0, 0.5, 1.0};  // [Hz]: period 2 s = 2000 samples
   const double phase[7] = {0.0, 0.7, 1.4, 2.1, 2.8, 3.5, 4.2};
-  if (n != 7) throw std::runtime_error("the benchmark trajectory expects the 7-DoF paper arm");
+  if (n != 7) throw std::runtime_error("the benchmark trajectory expects a 7-DoF arm");
   Data data(model);
   const auto sensor = model.find_frame("sensor");
   for (std::size_t k = 0; k < Trajectory::kNumSamples; ++k) {
@@ -234,9 +237,9 @@ Trajectory make_trajectory(const Model& model) {
     }
     forward_kinematics(model, data, q);
     if (k == 0) tr.X_WS = sensor ? frame_pose(model, data, *sensor) : Pose::identity();
-    const Pose& X_WB = data.X_WB[static_cast<std::size_t>(tr.contact_body)];
-    const ExternalWrench contact{tr.contact_body, X_WB.rotation * tr.contact_force_B,
-                                 X_WB.act(tr.contact_point_B), Vector3::Zero()};
+    const Pose& X_WB = data.X_WB[static_cast<std::size_t>(contact_spec.body)];
+    const ExternalWrench contact{contact_spec.body, X_WB.rotation * contact_spec.force_B,
+                                 X_WB.act(contact_spec.point_B), X_WB.rotation * contact_spec.moment_B};
     rnea_no_kinematics(model, data, dq, ddq, std::span<const ExternalWrench>(&contact, 1));
     tr.q.push_back(q);
     tr.dq.push_back(dq);
@@ -254,11 +257,88 @@ Trajectory make_trajectory(const Model& model) {
   return tr;
 }
 
+std::unique_ptr<MeshArm> load_panda() {
+  const std::filesystem::path urdf = std::filesystem::path(EXTWRENCH_SHARED_DIR) /
+                                     "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
+  if (!std::filesystem::exists(urdf)) return nullptr;
+  RobotDescription robot = load_urdf(urdf);
+  auto arm = std::make_unique<MeshArm>();
+  // Keep bodies 0..7 (link 0 to link 7 with the hand merged); the fingers come after them in
+  // the depth-first order and are dropped with their frames and shapes.
+  const int keep = robot.model.body_index("panda_link7") + 1;
+  Model& m = robot.model;
+  for (int b = keep; b < m.num_bodies(); ++b) {
+    if (m.parents[static_cast<std::size_t>(b)] < keep - 1) {
+      throw std::runtime_error("Panda: unexpected body order in " + urdf.string());
+    }
+  }
+  m.bodies.resize(static_cast<std::size_t>(keep));
+  m.joints.resize(static_cast<std::size_t>(keep));
+  m.parents.resize(static_cast<std::size_t>(keep));
+  std::erase_if(m.frames, [&](const Frame& f) { return f.body >= keep; });
+  GeometryModel g;
+  g.body_shapes.resize(static_cast<std::size_t>(keep));
+  for (const CollisionShape& shape : robot.geometry.shapes) {
+    if (shape.body >= keep) continue;
+    g.body_shapes[static_cast<std::size_t>(shape.body)].push_back(static_cast<int>(g.shapes.size()));
+    g.shapes.push_back(shape);
+  }
+  arm->model = std::move(m);
+  arm->geometry = std::move(g);
+  arm->source = "Panda (/work/shared, panda.relative.urdf, collision meshes, fingers dropped)";
+  return arm;
+}
+
+/// A pushing contact on the mesh of `body`: at the vertex farthest along +x of the body frame,
+/// force into the surface (−x) with a tangential part along y that loads the joint (axis z).
+ContactSpec mesh_contact(const GeometryModel& geometry, int body) {
+  ContactSpec c;
+  c.body = body;
+  double best = -1e300;
+  for (int s : geometry.body_shapes.at(static_cast<std::size_t>(body))) {
+    const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
+    if (shape.type != ShapeType::kMesh || !shape.mesh) continue;
+    for (Eigen::Index v = 0; v < shape.mesh->vertices.cols(); ++v) {
+      const Vector3 p_B = shape.placement.act(shape.mesh->vertices.col(v));
+      if (p_B.x() > best) {
+        best = p_B.x();
+        c.point_B = p_B;
+      }
+    }
+  }
+  if (best == -1e300) throw std::runtime_error("Panda: no collision mesh on the contact link");
+  c.force_B = Vector3(-15.0, 30.0, 0.0);
+  return c;
+}
+
 }  // namespace
 
-const Trajectory& trajectory() {
-  static const Trajectory tr = make_trajectory(paper_arm().model);
+const Trajectory& link6_trajectory() {
+  // On link 6's capsule (radius 0.065 m, axis z), pushing inward (−x) with a tangential part
+  // along z that gives joint 6 (axis −y) about 2 N m, well over the default τ_min = 1 N m.
+  static const Trajectory tr = make_trajectory(
+      paper_arm().model, {6, Vector3(0.065, 0.0, 0.01), Vector3(-15.0, 0.0, 30.0), Vector3::Zero()});
   return tr;
+}
+
+const Trajectory& flange_trajectory() {
+  static const Trajectory tr = make_trajectory(
+      paper_arm().model, {7, Vector3::Zero(), Vector3(10.0, -5.0, 8.0), Vector3(0.5, 0.3, 2.5)});
+  return tr;
+}
+
+const MeshArm* panda_arm() {
+  static const std::unique_ptr<MeshArm> arm = load_panda();
+  return arm.get();
+}
+
+const Trajectory* panda_trajectory() {
+  static const std::unique_ptr<Trajectory> tr = []() -> std::unique_ptr<Trajectory> {
+    const MeshArm* arm = panda_arm();
+    if (arm == nullptr) return nullptr;
+    return std::make_unique<Trajectory>(make_trajectory(arm->model, mesh_contact(arm->geometry, 6)));
+  }();
+  return tr.get();
 }
 
 const PaperArm& paper_arm() {

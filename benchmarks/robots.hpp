@@ -37,23 +37,47 @@ struct StatePool {
 };
 const StatePool& state_pool();
 
-/// A periodic, smooth joint trajectory sampled at 1 kHz, with a constant pure force on link 6
-/// (fixed in link 6's frame, applied at a point of its capsule's surface, pushing): the commanded
-/// torques τ = RNEA(q, q̇, q̈) − J_pᵀ F make the robot follow it exactly, and the base F/T sensor
-/// reads the robot's discharge plus the contact force. The estimator benchmarks replay it with
-/// t_k = k·dt; its period is a whole number of samples, so wrapping around stays smooth.
+/// A robot without KDL counterpart (collision meshes): the Panda arm of /work/shared, its finger
+/// bodies dropped (the estimators need a serial chain; the hand stays, merged into link 7).
+struct MeshArm {
+  Model model;
+  GeometryModel geometry;
+  std::string source;
+};
+/// nullptr when /work/shared's Panda is absent (the mesh benchmarks then skip).
+const MeshArm* panda_arm();
+
+/// The contact a trajectory carries: a constant wrench fixed in the frame of `body`.
+struct ContactSpec {
+  int body = 0;
+  Vector3 point_B = Vector3::Zero();   ///< application point, body frame [m]
+  Vector3 force_B = Vector3::Zero();   ///< [N], body frame
+  Vector3 moment_B = Vector3::Zero();  ///< pure moment [N m], body frame
+};
+
+/// A periodic, smooth joint trajectory sampled at 1 kHz with a constant contact wrench: the
+/// commanded torques τ = RNEA(q, q̇, q̈) − J_pᵀ W make the robot follow it exactly, and the base
+/// F/T sensor reads the robot's discharge plus the contact. The estimator benchmarks replay it
+/// with t_k = k·dt; its period is a whole number of samples, so wrapping around stays smooth.
 struct Trajectory {
   static constexpr std::size_t kNumSamples = 2000;  ///< 2 s: the frequencies are 0.5 and 1 Hz
   double dt = 1e-3;
-  int contact_body = 6;
-  Vector3 contact_point_B{0.065, 0.0, 0.01};  ///< on link 6's capsule (r = 0.065 m), body frame
-  Vector3 contact_force_B{-20.0, 4.0, 2.0};    ///< [N], body frame, into the surface
-  Pose X_WS;                                   ///< base sensor frame "sensor"
+  ContactSpec contact;
+  Pose X_WS;                                   ///< base sensor frame ("sensor", else the root)
   std::vector<VectorX> q, dq, ddq, tau;
   std::vector<Vector6> ft_S;                   ///< base F/T reading [f_m; n_m] in the sensor frame
   std::vector<KDL::JntArray> kq, kdq, ktau;
 };
-const Trajectory& trajectory();
+/// Paper arm, pure force on link 6 pushing on its capsule (the paper's contact link).
+const Trajectory& link6_trajectory();
+/// Paper arm, force and moment at the flange (link 7's origin): KDL's estimator's assumption.
+const Trajectory& flange_trajectory();
+/// Panda, pure force on link 6 pushing on its collision mesh (nullptr without the Panda).
+const Trajectory* panda_trajectory();
+
+/// Registers the ContactEstimator benchmarks (one per Table I configuration, the Panda's meshes
+/// when present, the latency runs); called by main after the robots loaded.
+void register_contact_benchmarks();
 
 /// Allocations per call of `f`, over `calls` calls after one warm-up call.
 template <class F>

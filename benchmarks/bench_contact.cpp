@@ -1,0 +1,205 @@
+// The full per-sample update of ContactEstimator (residual + q̈̂ + no-contact base RNEA + detection
+// and isolation + the Table I case + the point on the link's geometry), for every configuration
+// of Table I, and the like-for-like comparison with KDL's JntToExtWrench (case E, l = n).
+// Each estimator first runs kWarmup samples so that the contact is declared and every sample
+// timed takes the full path; the counters "contact", "link" and "surface" say that it did.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include <kdl/chainexternalwrenchestimator.hpp>
+
+#include "extwrench/estimation/contact_estimator.hpp"
+#include "robots.hpp"
+
+namespace extwrench::bench {
+namespace {
+
+constexpr double kGain = 100.0;         ///< K [1/s] on every joint (KDL's estimation_gain too)
+constexpr std::size_t kWarmup = 500;    ///< samples before timing: past detection's min_duration
+constexpr std::size_t kLatencyCalls = 1'000'000;
+constexpr std::size_t kKdlLatencyCalls = 200'000;
+
+std::size_t sample(std::size_t k) { return k % Trajectory::kNumSamples; }
+double stamp(std::size_t k, const Trajectory& tr) { return static_cast<double>(k) * tr.dt; }
+
+struct Config {
+  SensorType sensor;
+  ContactModel contact;
+  const char* name;
+};
+constexpr Config kTableI[] = {
+    {SensorType::kForceTorque, ContactModel::kPureForce, "ft/pure_force"},
+    {SensorType::kForceTorque, ContactModel::kKnownPoint, "ft/known_point"},
+    {SensorType::kForce, ContactModel::kPureForce, "force/pure_force"},
+    {SensorType::kForce, ContactModel::kKnownPoint, "force/known_point"},
+    {SensorType::kNone, ContactModel::kPureForce, "none/pure_force"},
+    {SensorType::kNone, ContactModel::kKnownPoint, "none/known_point"},
+};
+
+EstimatorOptions options_for(const Config& c, const Trajectory& tr) {
+  EstimatorOptions o;
+  o.sensor.type = c.sensor;
+  o.sensor.pose = tr.X_WS;
+  o.contact.model = c.contact;
+  if (c.contact == ContactModel::kKnownPoint) {
+    o.contact.link = tr.contact.body;
+    o.contact.point = tr.contact.point_B;
+  }
+  o.observer_gain = VectorX::Constant(1, kGain);
+  return o;
+}
+
+/// Replays `tr` through one estimator; call(k) runs sample k (k increases: t_k = k dt).
+class Replay {
+ public:
+  Replay(const Model& model, const GeometryModel& geometry, const EstimatorOptions& options,
+         const Trajectory& tr)
+      : estimator_(model, geometry, options), tr_(tr), with_sensor_(options.sensor.type != SensorType::kNone) {
+    ok_ = estimator_.reset(0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok();
+    while (k_ < kWarmup) step();
+  }
+  bool ok() const { return ok_; }
+  Status step() {
+    const std::size_t s = sample(k_);
+    const double t = stamp(k_, tr_);
+    ++k_;
+    return with_sensor_ ? estimator_.update(t, tr_.q[s], tr_.dq[s], tr_.tau[s], tr_.ft_S[s])
+                        : estimator_.update(t, tr_.q[s], tr_.dq[s], tr_.tau[s]);
+  }
+  const ContactEstimator& estimator() const { return estimator_; }
+
+ private:
+  ContactEstimator estimator_;
+  const Trajectory& tr_;
+  bool with_sensor_;
+  bool ok_ = false;
+  std::size_t k_ = 1;
+};
+
+void report(benchmark::State& state, const Replay& replay, double allocs) {
+  const ContactEstimate& e = replay.estimator().result();
+  state.counters["allocs"] = allocs;
+  state.counters["contact"] = e.contact ? 1.0 : 0.0;
+  state.counters["link"] = e.link;
+  state.counters["surface"] = e.has(EstimateFlag::kSurfacePoint) ? 1.0 : 0.0;
+  state.SetLabel(describe_flags(e.flags));
+}
+
+void run_update(benchmark::State& state, const Model& model, const GeometryModel& geometry,
+                const EstimatorOptions& options, const Trajectory& tr) {
+  Replay replay(model, geometry, options, tr);
+  if (!replay.ok()) {
+    state.SkipWithError("estimator reset failed");
+    return;
+  }
+  for (auto _ : state) {
+    const Status st = replay.step();
+    benchmark::DoNotOptimize(st);
+  }
+  const double allocs = allocations_per_call([&](int) { (void)replay.step(); });
+  report(state, replay, allocs);
+}
+
+// Like for like with KDL's JntToExtWrench: the residual and the wrench at the flange origin from
+// the joint torques alone (case E, l = n, known point = link 7's origin), detection included.
+void BM_ResidualEeWrench_Ours(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const Trajectory& tr = flange_trajectory();
+  const Config c{SensorType::kNone, ContactModel::kKnownPoint, "none/known_point"};
+  run_update(state, arm.model, arm.geometry, options_for(c, tr), tr);
+}
+BENCHMARK(BM_ResidualEeWrench_Ours);
+
+// Latency of single calls measured with the steady clock over many calls: min, median, p99,
+// p99.9, max [ns]. The clock's own cost (a back-to-back pair of now()) is reported as clock_ns
+// and is included in every figure.
+template <class Step>
+void measure_latency(benchmark::State& state, std::size_t calls, Step&& step) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<std::int64_t> ns(calls);
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < calls; ++i) {
+      const auto t0 = Clock::now();
+      step();
+      const auto t1 = Clock::now();
+      ns[i] = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
+    }
+  }
+  std::vector<std::int64_t> clock(10000);
+  for (auto& c : clock) {
+    const auto t0 = Clock::now();
+    const auto t1 = Clock::now();
+    c = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
+  }
+  std::sort(ns.begin(), ns.end());
+  std::nth_element(clock.begin(), clock.begin() + clock.size() / 2, clock.end());
+  auto at = [&](double p) {
+    return static_cast<double>(ns[std::min(ns.size() - 1, static_cast<std::size_t>(p * static_cast<double>(ns.size())))]);
+  };
+  state.counters["calls"] = static_cast<double>(calls);
+  state.counters["min_ns"] = static_cast<double>(ns.front());
+  state.counters["p50_ns"] = at(0.5);
+  state.counters["p99_ns"] = at(0.99);
+  state.counters["p999_ns"] = at(0.999);
+  state.counters["max_ns"] = static_cast<double>(ns.back());
+  state.counters["clock_ns"] = static_cast<double>(clock[clock.size() / 2]);
+}
+
+}  // namespace
+
+void register_contact_benchmarks() {
+  const PaperArm& arm = paper_arm();
+  const Trajectory& link6 = link6_trajectory();
+  for (const Config& c : kTableI) {
+    benchmark::RegisterBenchmark(
+        (std::string("BM_FullUpdate_Ours/") + c.name + "/capsules").c_str(),
+        [&arm, &link6, c](benchmark::State& state) {
+          run_update(state, arm.model, arm.geometry, options_for(c, link6), link6);
+        });
+  }
+  if (const MeshArm* panda = panda_arm(); panda != nullptr) {
+    const Trajectory& tr = *panda_trajectory();
+    for (const Config& c : {kTableI[0], kTableI[4]}) {
+      benchmark::RegisterBenchmark(
+          (std::string("BM_FullUpdate_Ours/") + c.name + "/panda_meshes").c_str(),
+          [panda, &tr, c](benchmark::State& state) {
+            run_update(state, panda->model, panda->geometry, options_for(c, tr), tr);
+          });
+    }
+  }
+  // Latency distributions: our full F/T unknown-point update, and KDL's estimator for contrast.
+  benchmark::RegisterBenchmark(
+      "BM_Latency_Ours/ft/pure_force/capsules",
+      [&arm, &link6](benchmark::State& state) {
+        Replay replay(arm.model, arm.geometry, options_for(kTableI[0], link6), link6);
+        measure_latency(state, kLatencyCalls, [&] { benchmark::DoNotOptimize(replay.step()); });
+        report(state, replay, 0.0);
+        state.counters.erase("allocs");
+      })
+      ->Iterations(1)
+      ->Repetitions(1)
+      ->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark(
+      "BM_Latency_Kdl/JntToExtWrench",
+      [&arm](benchmark::State& state) {
+        const Trajectory& tr = flange_trajectory();
+        const KDL::Vector g(arm.model.gravity.x(), arm.model.gravity.y(), arm.model.gravity.z());
+        KDL::ChainExternalWrenchEstimator estimator(arm.chain, g, 1.0 / tr.dt, kGain, 0.0);
+        (void)estimator.setInitialMomentum(tr.kq[0], tr.kdq[0]);
+        KDL::Wrench w;
+        std::size_t k = 1;
+        measure_latency(state, kKdlLatencyCalls, [&] {
+          const std::size_t s = sample(k++);
+          benchmark::DoNotOptimize(estimator.JntToExtWrench(tr.kq[s], tr.kdq[s], tr.ktau[s], w));
+        });
+      })
+      ->Iterations(1)
+      ->Repetitions(1)
+      ->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace extwrench::bench
