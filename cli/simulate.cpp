@@ -65,7 +65,7 @@ void run_simulate(const SimulateOptions& opt) {
                     cell(m.force.max, "%.2f").c_str(), b ? cell(b->metrics.force.rms(), "%.3f").c_str() : "-",
                     cell(m.line.rms(), "%.4f").c_str(), cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
                     cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
-                    cell(r.peak_condition, "%.0f").c_str());
+                    cell(r.peak_condition, "%.3g").c_str());
       }
     }
   }
