@@ -29,7 +29,9 @@ Data::Data(const Model& model) {
   ddq = VectorX::Zero(n);
   J = Matrix6X::Zero(6, n);
   tmp_n = VectorX::Zero(n);
-  mass_llt = Eigen::LLT<MatrixX>(n);
+  // Sized by a factorization rather than by copying LLT(n), whose ComputationInfo is left
+  // uninitialized by Eigen (UBSan: invalid enum load in the copy).
+  mass_llt.compute(MatrixX::Identity(n, n));
 }
 
 }  // namespace extwrench
