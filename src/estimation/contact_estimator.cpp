@@ -249,13 +249,27 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
       ddq_.setConstant(kNaN);
     } else {
       data.mass_llt.solveInPlace(ddq_);
+      // The no-contact ground wrench (f̃_g, ñ_g) is affine in q̈: f_0(q̈̂) = f_0(0) + Σ_j Ic_j S_j q̈̂_j,
+      // Ic_j the composite inertia of the subtree of j that the CRBA just left in `data`
+      // (about the world origin). Saves a second RNEA pass.
+      Vector6 f0 = data.root_wrench_W;
+      for (int j = 1; j < model.num_bodies(); ++j) {
+        const auto js = static_cast<std::size_t>(j);
+        const Vector6& s = data.S[js];
+        const double m = data.composite_mass[js];
+        const Vector3& h = data.composite_first_moment[js];
+        const double a = ddq_[j - 1];
+        f0.head<3>() += a * (m * s.head<3>() - h.cross(s.tail<3>()));
+        f0.tail<3>() += a * (h.cross(s.head<3>()) + data.composite_inertia_O[js] * s.tail<3>());
+      }
+      data.root_wrench_W = f0;
     }
   } else {
     ddq_.setConstant(kNaN);
   }
-  if (need_ddq && out_.status.ok()) {
-    // One RNEA pass with W_ext = 0 and q̈ = q̈̂: the no-contact ground wrench (f̃_g, ñ_g) in
-    // data.root_wrench_W, and τ_tot in data.tau.
+  if (options_.acceleration == AccelerationRoute::kDifferentiation && out_.status.ok()) {
+    // One RNEA pass with W_ext = 0 and q̈ = q̈̂: τ_tot in data.tau and the no-contact ground
+    // wrench (f̃_g, ñ_g) in data.root_wrench_W.
     rnea_no_kinematics(model, data, dq, ddq_);
   }
   if (options_.acceleration == AccelerationRoute::kDifferentiation) {
