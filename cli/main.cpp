@@ -22,11 +22,15 @@ Examples:
       joint torques and the base sensor reading for each row t, q1..qn, dq1..dqn, ddq1..ddqn
   extwrench dynamics --robot arm.urdf --sensor-pose "0 0 -0.05 0 0 3.1416" --in states.csv --out -
       the same with the sensor 5 cm below the root link, turned by 180 deg; CSV to stdout
+  extwrench simulate scenarios/paper.yaml --out results/paper
+      the paper's experiment: closed-loop simulation, then every estimator scheme on its log
+  extwrench estimate --config scheme.yaml --log log.csv --out results/replay
+      replay a recorded (or simulated) log through the contact estimator
   extwrench COMMAND --help
       all options of one command
 
 Units are SI and radians throughout. Exit status: 0 success, 1 bad input file, 2 bad command line.
-Documentation: docs/cli.md (commands, CSV formats), README.md.)";
+Documentation: docs/cli.md (commands, CSV), docs/log_format.md, docs/config.md, README.md.)";
 
 }  // namespace
 
