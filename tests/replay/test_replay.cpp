@@ -63,6 +63,8 @@ class Replay : public ::testing::Test {
  protected:
   static void SetUpTestSuite() { robot_ = new RobotDescription(load_robot(kPaperArm)); }
   static void TearDownTestSuite() {
+    std::error_code ignored;
+    fs::remove_all(fs::temp_directory_path() / ("extwrench_test_replay_" + std::to_string(::getpid())), ignored);
     delete robot_;
     robot_ = nullptr;
   }
