@@ -35,7 +35,7 @@ def load(path, use_real):
         doc = json.load(f)
     runs = {}  # run_name -> entry (median aggregate preferred, else the single run)
     for b in doc.get("benchmarks", []):
-        name = b.get("run_name", b["name"])
+        name = b.get("run_name", b["name"]).replace("/iterations:1/repeats:1", "")
         if b.get("run_type") == "aggregate":
             if b.get("aggregate_name") != "median":
                 continue

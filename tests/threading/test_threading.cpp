@@ -15,6 +15,7 @@
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/observer/momentum_observer.hpp"
 #include "support/random.hpp"
@@ -118,6 +119,106 @@ TEST(Threading, OneMomentumObserverPerThreadMatchesSingleThreadedBitForBit) {
   for (int k = 0; k < kThreads; ++k) {
     EXPECT_TRUE(bit_identical(outputs[static_cast<std::size_t>(k)], reference)) << "thread " << k;
   }
+}
+
+// The whole estimator, F/T sensor and unknown point, so that every stage runs (residual, q̈̂,
+// base RNEA, isolation, case C, the line meeting the link's shapes). The robot description —
+// Panda meshes and their ray casters included when /work/shared is present — is shared const;
+// each thread builds its own ContactEstimator from it.
+void expect_estimators_match(const RobotDescription& robot, int contact_body, const Vector3& point_B,
+                             const Vector3& force_B) {
+  const Model& model = robot.model;
+  const int n = model.nq();
+  // A smooth motion with a constant push on `contact_body`; τ and the base reading from RNEA.
+  std::vector<VectorX> q, dq, tau;
+  std::vector<Vector6> reading;
+  {
+    Data data(model);
+    for (int k = 0; k < 1500; ++k) {
+      const double t = k * 1e-3;
+      VectorX qk(n), dqk(n), ddqk(n);
+      for (int i = 0; i < n; ++i) {
+        const double w = 2.0 + 0.5 * i;
+        qk[i] = 0.5 + 0.3 * std::sin(w * t + i);
+        dqk[i] = 0.3 * w * std::cos(w * t + i);
+        ddqk[i] = -0.3 * w * w * std::sin(w * t + i);
+      }
+      forward_kinematics(model, data, qk);
+      const Pose& X = data.X_WB[static_cast<std::size_t>(contact_body)];
+      const ExternalWrench w{contact_body, X.rotation * force_B, X.act(point_B), Vector3::Zero()};
+      rnea_no_kinematics(model, data, dqk, ddqk, std::span(&w, 1));
+      q.push_back(qk);
+      dq.push_back(dqk);
+      tau.push_back(data.tau);
+      reading.push_back(sensor_reading(data, Pose::identity()));
+    }
+  }
+  EstimatorOptions options;
+  options.sensor.type = SensorType::kForceTorque;
+  options.contact.model = ContactModel::kPureForce;
+  auto work = [&] {
+    ContactEstimator estimator(model, robot.geometry, options);
+    std::vector<double> out;
+    EXPECT_TRUE(estimator.reset(0.0, q[0], dq[0], tau[0]).ok());
+    for (std::size_t k = 1; k < q.size(); ++k) {
+      EXPECT_TRUE(estimator.update(static_cast<double>(k) * 1e-3, q[k], dq[k], tau[k], reading[k]).ok());
+      const ContactEstimate& e = estimator.result();
+      out.push_back(e.link);
+      out.push_back(e.flags);
+      append(out, e.force_W);
+      append(out, e.point_W);
+      append(out, e.line_point_W);
+      append(out, e.residual);
+    }
+    // Last: did the run exercise the full path (contact declared on the right link, a point)?
+    const ContactEstimate& last = estimator.result();
+    out.push_back(last.contact && last.link == contact_body && last.has(EstimateFlag::kLineOfAction));
+    return out;
+  };
+  const std::vector<double> reference = work();
+  ASSERT_FALSE(reference.empty());
+  EXPECT_EQ(reference.back(), 1.0) << "the single-threaded run did not locate the contact";
+  const auto outputs = run_concurrently(work);
+  for (int k = 0; k < kThreads; ++k) {
+    EXPECT_TRUE(bit_identical(outputs[static_cast<std::size_t>(k)], reference)) << "thread " << k;
+  }
+}
+
+TEST(Threading, OneContactEstimatorPerThreadOnSharedCapsulesMatchesSingleThreaded) {
+  // Link 6's capsule (radius 0.065 m) of models/paper_arm.urdf, pushed inward.
+  expect_estimators_match(paper_arm(), 6, Vector3(0.065, 0.0, 0.01), Vector3(-15.0, 0.0, 30.0));
+}
+
+TEST(Threading, OneContactEstimatorPerThreadOnSharedPandaMeshesMatchesSingleThreaded) {
+  const std::filesystem::path urdf = std::filesystem::path(EXTWRENCH_SHARED_DIR) /
+      "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
+  if (!std::filesystem::exists(urdf)) GTEST_SKIP() << "no " << urdf;
+  RobotDescription panda = load_robot(urdf);
+  // The estimator needs a serial chain: keep link 0..7 (hand merged), drop the fingers.
+  const int keep = panda.model.body_index("panda_link7") + 1;
+  panda.model.bodies.resize(static_cast<std::size_t>(keep));
+  panda.model.joints.resize(static_cast<std::size_t>(keep));
+  panda.model.parents.resize(static_cast<std::size_t>(keep));
+  std::erase_if(panda.model.frames, [&](const Frame& f) { return f.body >= keep; });
+  GeometryModel g;
+  g.body_shapes.resize(static_cast<std::size_t>(keep));
+  for (const CollisionShape& shape : panda.geometry.shapes) {
+    if (shape.body >= keep) continue;
+    g.body_shapes[static_cast<std::size_t>(shape.body)].push_back(static_cast<int>(g.shapes.size()));
+    g.shapes.push_back(shape);
+  }
+  panda.geometry = std::move(g);
+  // A vertex of link 6's mesh farthest along +x, pushed along −x (into the mesh) and +y.
+  Vector3 point = Vector3::Constant(-1e9);
+  for (int s : panda.geometry.body_shapes[6]) {
+    const CollisionShape& shape = panda.geometry.shapes[static_cast<std::size_t>(s)];
+    ASSERT_TRUE(shape.mesh);
+    for (Eigen::Index v = 0; v < shape.mesh->vertices.cols(); ++v) {
+      const Vector3 p = shape.placement.act(shape.mesh->vertices.col(v));
+      if (p.x() > point.x()) point = p;
+    }
+  }
+  expect_estimators_match(panda, 6, point, Vector3(-15.0, 30.0, 0.0));
 }
 
 }  // namespace
