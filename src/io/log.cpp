@@ -247,7 +247,12 @@ std::string EstimatesWriter::status_text(const ContactEstimate& e) {
     std::string s(to_string(e.status.code));
     s += ':';
     s += to_string(e.status.channel);
-    if (e.status.index >= 0) s += "[" + std::to_string(e.status.index) + "]";
+    if (e.status.index >= 0) {
+      // Appended piecewise: GCC 12 -O3 reports a false -Wrestrict on "[" + std::string.
+      s += '[';
+      s += std::to_string(e.status.index);
+      s += ']';
+    }
     return s;
   }
   return describe_flags(e.flags);
