@@ -6,6 +6,8 @@ packages=(
   libeigen3-dev libtinyxml2-dev libyaml-cpp-dev libcli11-dev libassimp-dev libembree-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   liborocos-kdl-dev libkdl-parser-dev libmujoco-dev
+  # MuJoCo's CMake config requires OpenGL (find_dependency), which libmujoco-dev only recommends.
+  libgl-dev libopengl-dev libglx-dev
   gnuplot-nox
 )
 missing=()
