@@ -8,6 +8,8 @@ packages=(
   liborocos-kdl-dev libkdl-parser-dev libmujoco-dev
   # MuJoCo's CMake config requires OpenGL (find_dependency), which libmujoco-dev only recommends.
   libgl-dev libopengl-dev libglx-dev
+  # assimp's CMake targets link libz.so, which libassimp-dev does not pull in.
+  zlib1g-dev
   gnuplot-nox
 )
 missing=()
