@@ -10,23 +10,8 @@ void forward_kinematics(const Model& model, Data& data, const Eigen::Ref<const V
   data.S[0].setZero();
   for (int i = 0; i < nb; ++i) {
     if (i > 0) {
-      const Joint& joint = model.joints[i];
-      const Pose& X_WP = data.X_WB[model.parents[i]];
-      Pose& X_WB = data.X_WB[i];
-      const Matrix3 R_WJ = X_WP.rotation * joint.placement.rotation;  // joint frame at q = 0
-      X_WB.translation = X_WP.act(joint.placement.translation);
-      const Vector3 axis_W = R_WJ * joint.axis;
-      const double qi = q[i - 1];
-      if (joint.type == JointType::kRevolute) {
-        X_WB.rotation.noalias() = R_WJ * detail::axis_rotation(joint.axis, qi);
-        // Revolute about axis z through O_i: velocity of the body point at the world origin
-        // is O_i x z q_dot.
-        data.S[i] << X_WB.translation.cross(axis_W), axis_W;
-      } else {
-        X_WB.rotation = R_WJ;
-        X_WB.translation += axis_W * qi;
-        data.S[i] << axis_W, Vector3::Zero();
-      }
+      detail::joint_kinematics(model.joints[i], data.X_WB[model.parents[i]], q[i - 1],
+                               data.X_WB[i], data.S[i]);
     }
     // Mass properties about the world origin: h = m c_W, I_O = R I_c R^T + m (|c|^2 1 - c c^T).
     const Inertia& inertia = model.bodies[i].inertia;
@@ -35,10 +20,20 @@ void forward_kinematics(const Model& model, Data& data, const Eigen::Ref<const V
     const double m = inertia.mass;
     data.mass[i] = m;
     data.first_moment_W[i] = m * c_W;
+    // Symmetric: A = R I_c once, then only the lower triangle of A R^T + m (|c|^2 1 - c c^T).
+    Matrix3 A;
+    A.noalias() = X.rotation * inertia.inertia_com;
+    const Vector3 h = m * c_W;
+    const double mc2 = h.dot(c_W);
     Matrix3& I_O = data.inertia_O_W[i];
-    I_O.noalias() = X.rotation * inertia.inertia_com * X.rotation.transpose();
-    I_O.diagonal().array() += m * c_W.squaredNorm();
-    I_O.noalias() -= m * c_W * c_W.transpose();
+    for (int r = 0; r < 3; ++r) {
+      for (int col = 0; col <= r; ++col) {
+        const double e = A.row(r).dot(X.rotation.row(col)) - h[r] * c_W[col];
+        I_O(r, col) = e;
+        I_O(col, r) = e;
+      }
+      I_O(r, r) += mc2;
+    }
   }
 }
 

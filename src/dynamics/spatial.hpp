@@ -3,7 +3,10 @@
 // 6x6 matrix is formed on the hot path.
 #pragma once
 
+#include <cmath>
+
 #include "extwrench/core/types.hpp"
+#include "extwrench/model/model.hpp"
 
 namespace extwrench::detail {
 
@@ -67,6 +70,52 @@ inline Matrix3 axis_rotation(const Vector3& axis, double angle) {
       t * x * y + s * z, t * y * y + c, t * y * z - s * x,   //
       t * x * z - s * y, t * y * z + s * x, t * z * z + c;
   return r;
+}
+
+/// R * Rot(axis, angle) for a body whose joint frame has world rotation R (s = sin, c = cos).
+/// A coordinate axis (+-x, +-y, +-z, the URDF/DH norm) only mixes two columns of R (12 flops
+/// instead of Rodrigues plus a 3x3 product); any other axis takes the general path.
+inline void rotate_about_axis(const Matrix3& R, const Vector3& axis, double s, double c,
+                              Matrix3& out) {
+  for (int k = 0; k < 3; ++k) {
+    const int i = (k + 1) % 3;
+    const int j = (k + 2) % 3;
+    if (axis[i] == 0.0 && axis[j] == 0.0 && (axis[k] == 1.0 || axis[k] == -1.0)) {
+      // Rot(e_k, q): column i -> c e_i + s e_j, column j -> -s e_i + c e_j (s flips with -e_k).
+      const double sk = axis[k] * s;
+      out.col(k) = R.col(k);
+      out.col(i) = c * R.col(i) + sk * R.col(j);
+      out.col(j) = c * R.col(j) - sk * R.col(i);
+      return;
+    }
+  }
+  const double t = 1.0 - c;
+  const double x = axis.x(), y = axis.y(), z = axis.z();
+  Matrix3 r;
+  r << t * x * x + c, t * x * y - s * z, t * x * z + s * y,  //
+      t * x * y + s * z, t * y * y + c, t * y * z - s * x,   //
+      t * x * z - s * y, t * y * z + s * x, t * z * z + c;
+  out.noalias() = R * r;
+}
+
+/// Pose X_WB of body i and its joint's motion subspace S_i (world, about the world origin),
+/// from the parent's pose X_WP and q_i.
+inline void joint_kinematics(const Joint& joint, const Pose& X_WP, double qi, Pose& X_WB,
+                             Vector6& S) {
+  const Matrix3 R_WJ = X_WP.rotation * joint.placement.rotation;  // joint frame at q = 0
+  X_WB.translation.noalias() = X_WP.rotation * joint.placement.translation;
+  X_WB.translation += X_WP.translation;
+  const Vector3 axis_W = R_WJ * joint.axis;
+  if (joint.type == JointType::kRevolute) {
+    rotate_about_axis(R_WJ, joint.axis, std::sin(qi), std::cos(qi), X_WB.rotation);
+    // Revolute about axis z through O_i: velocity of the body point at the world origin
+    // is O_i x z q_dot.
+    S << X_WB.translation.cross(axis_W), axis_W;
+  } else {
+    X_WB.rotation = R_WJ;
+    X_WB.translation += axis_W * qi;
+    S << axis_W, Vector3::Zero();
+  }
 }
 
 }  // namespace extwrench::detail

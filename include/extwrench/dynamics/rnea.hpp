@@ -18,7 +18,10 @@ struct ExternalWrench {
 
 /// Inverse dynamics tau = B(q) ddq + C(q, dq) dq + g(q) - sum_k J_k^T W_k, eqs. (7)-(12),
 /// iterated down to link 0: data.root_wrench_W is f_0 (the wrench the ground applies to link 0,
-/// about the world origin, link 0's own weight included). Runs forward_kinematics.
+/// about the world origin, link 0's own weight included). Computes the poses data.X_WB and
+/// data.S of forward_kinematics (with data.v, data.a, data.f), but not its world mass properties
+/// (data.mass, first_moment_W, inertia_O_W): the Newton-Euler step uses the body-axes inertia
+/// about the CoM instead. Run forward_kinematics before any *_no_kinematics algorithm.
 /// q, dq, ddq: (n). Returns data.tau.
 const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& ddq,
