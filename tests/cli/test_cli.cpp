@@ -253,6 +253,69 @@ TEST_F(Cli, InfoReportsAMissingOrMalformedRobotFileAsAnInputError) {
   EXPECT_EQ(run("info").code, kExitUsageError);  // ROBOT missing
 }
 
+TEST_F(Cli, InfoResolvesPackageUrisThroughThePackagePathOption) {
+  // A tetrahedron as ASCII STL inside a package "tiny_description".
+  fs::create_directories(path("pkgs/tiny_description/meshes"));
+  write_text(path("pkgs/tiny_description/meshes/tet.stl"), R"(solid tet
+facet normal 0 0 -1
+ outer loop
+  vertex 0 0 0
+  vertex 0 1 0
+  vertex 1 0 0
+ endloop
+endfacet
+facet normal 0 -1 0
+ outer loop
+  vertex 0 0 0
+  vertex 1 0 0
+  vertex 0 0 1
+ endloop
+endfacet
+facet normal -1 0 0
+ outer loop
+  vertex 0 0 0
+  vertex 0 0 1
+  vertex 0 1 0
+ endloop
+endfacet
+facet normal 1 1 1
+ outer loop
+  vertex 1 0 0
+  vertex 0 1 0
+  vertex 0 0 1
+ endloop
+endfacet
+endsolid tet
+)");
+  write_text(path("tiny.urdf"), R"(<robot name="tiny">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="tip"><inertial><mass value="0.5"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><mesh filename="package://tiny_description/meshes/tet.stl" scale="2 2 2"/></geometry></collision></link>
+  <joint name="slide" type="prismatic"><parent link="base"/><child link="tip"/><axis xyz="1 0 0"/><limit lower="-0.1" upper="0.2" effort="50" velocity="1"/></joint>
+</robot>)");
+  const RunResult without = run("info " + quoted("tiny.urdf"));
+  EXPECT_EQ(without.code, kExitInputError);
+  EXPECT_TRUE(contains(without.err, "tiny.urdf:4"));
+  EXPECT_TRUE(contains(without.err, "package://tiny_description/meshes/tet.stl"));
+
+  const RunResult with = run("info --package-path " + quoted("pkgs") + " " + quoted("tiny.urdf"));
+  ASSERT_EQ(with.code, 0) << with.err;
+  EXPECT_TRUE(contains(with.out, "tet.stl', 4 triangles, scale (2, 2, 2)"));
+  EXPECT_TRUE(contains(with.out, "q1  slide  prismatic  base -> tip"));
+  EXPECT_TRUE(contains(with.out, "limits [-0.1, 0.2] m, velocity 1 m/s, effort 50 N"));
+}
+
+TEST_F(Cli, InfoOnThePandaShowsATreeWithItsFingers) {
+  const fs::path panda = fs::path(EXTWRENCH_SHARED_DIR) / "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
+  if (!fs::exists(panda)) GTEST_SKIP() << "needs " << panda;
+  const UrdfFacts facts = read_urdf_facts(panda);
+  const RunResult r = run("info '" + panda.string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.out, "joints: 9, tree"));
+  for (const std::string& link : facts.links) EXPECT_TRUE(contains(r.out, "  " + link + "  ")) << link;
+  EXPECT_NEAR(printed_total_mass(r.out), facts.total_mass, 1e-9 * facts.total_mass);
+}
+
 // ---- dynamics: round trip against the library --------------------------------------------
 
 struct States {
