@@ -99,11 +99,11 @@ class Cli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   /// Runs the binary with `args` (already shell-quoted where needed), capturing both streams.
-  RunResult run(const std::string& args) const {
+  RunResult run(const std::string& args, const std::string& stdin_file = "/dev/null") const {
     const fs::path out = dir_ / "stdout.txt";
     const fs::path err = dir_ / "stderr.txt";
     const std::string command = std::string("'") + EXTWRENCH_CLI + "' " + args + " >'" + out.string() +
-                                "' 2>'" + err.string() + "' </dev/null";
+                                "' 2>'" + err.string() + "' <'" + stdin_file + "'";
     const int status = std::system(command.c_str());
     RunResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -442,6 +442,37 @@ TEST_F(Cli, DynamicsOfAStaticArmReadsItsWeight) {
   EXPECT_NEAR(reader.number(reader.column("fs_x")), 0.0, 1e-9);
   EXPECT_NEAR(reader.number(reader.column("fs_y")), 0.0, 1e-9);
   EXPECT_NEAR(reader.number(reader.column("fs_z")), -weight, 1e-9 * weight);
+}
+
+TEST_F(Cli, DynamicsReadsStdinAndWritesStdoutWithADash) {
+  const fs::path yaml = kModels / "paper_arm.yaml";
+  const RobotDescription robot = load_robot(yaml);
+  const States s = random_states(robot.model.nq(), 3, 13);
+  write_states(path("states.csv"), s, robot.model.nq());
+  const RunResult r = run("dynamics --robot '" + yaml.string() + "' --in - --out -", path("states.csv").string());
+  ASSERT_EQ(r.code, 0) << r.err;
+  write_text(path("out.csv"), r.out);
+  Pose X_WS;
+  X_WS.translation = Vector3(0.0, 0.0, -0.31);  // the frame 'sensor' of models/README.md
+  expect_output_matches_library(path("out.csv"), robot, s, X_WS);
+}
+
+TEST_F(Cli, DynamicsRefusesASensorFrameOnAMovingLink) {
+  write_text(path("arm.urdf"), R"(<robot name="arm">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="arm"><inertial><mass value="0.5"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="sensor"/>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/></joint>
+  <joint name="mount" type="fixed"><parent link="arm"/><child link="sensor"/></joint>
+</robot>)");
+  write_text(path("states.csv"), "t,q1,dq1,ddq1\n0,0,0,0\n");
+  const std::string base = "dynamics --robot " + quoted("arm.urdf") + " --in " + quoted("states.csv") + " --out " + quoted("out.csv");
+  const RunResult r = run(base);
+  EXPECT_EQ(r.code, kExitInputError);
+  EXPECT_TRUE(contains(r.err, "frame 'sensor' is attached to the moving body 'arm'"));
+  EXPECT_TRUE(contains(r.err, "give --sensor-pose instead"));
+  // An explicit pose is the way out.
+  EXPECT_EQ(run(base + " --sensor-pose '0 0 0 0 0 0'").code, 0);
 }
 
 // ---- dynamics: malformed inputs ----------------------------------------------------------
