@@ -157,6 +157,13 @@ Status MomentumObserver::update(double t, const Eigen::Ref<const VectorX>& q,
                                 const Eigen::Ref<const VectorX>& tau) noexcept {
   // Every input is checked before any state changes: a bad sample leaves no trace.
   if (Status s = validate(t, q, dq, tau); !s.ok()) return s;
+  advance(t, q, dq, tau);
+  return Status::success();
+}
+
+void MomentumObserver::advance(double t, const Eigen::Ref<const VectorX>& q,
+                               const Eigen::Ref<const VectorX>& dq,
+                               const Eigen::Ref<const VectorX>& tau) noexcept {
   const double dt = t - t_;
   compute_terms(q, dq);
   if (dt != alpha_dt_) {
@@ -180,7 +187,6 @@ Status MomentumObserver::update(double t, const Eigen::Ref<const VectorX>& q,
   q_prev_ = q;
   dq_prev_ = dq;
   t_ = t;
-  return Status::success();
 }
 
 }  // namespace extwrench

@@ -27,6 +27,8 @@
 
 #include <optional>
 
+#include <Eigen/Cholesky>
+
 #include "extwrench/estimation/contact_detector.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
 #include "extwrench/geometry/shapes.hpp"
@@ -155,6 +157,11 @@ class ContactEstimator {
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;
   Matrix6X J_;
   ContactEstimate out_;
+  // Cholesky of B(q) for q̈̂ with storage inside the object (up to kInlineJoints joints): the
+  // fixed-capacity factorisation and solves are faster than the dynamic-size ones in Data.
+  static constexpr int kInlineJoints = 12;
+  Eigen::LLT<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kInlineJoints, kInlineJoints>>
+      mass_llt_;
 };
 
 }  // namespace extwrench

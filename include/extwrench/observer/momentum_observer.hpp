@@ -89,6 +89,11 @@ class MomentumObserver {
   [[nodiscard]] const Data& workspace() const noexcept { return data_; }
 
  private:
+  friend class ContactEstimator;  // validates the sample itself, then calls advance()
+
+  /// update() without the input checks: the caller has validated (t, q, q̇, τ).
+  void advance(double t, const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
+               const Eigen::Ref<const VectorX>& tau) noexcept;
   void compute_terms(const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq) noexcept;
   void apply_payload(int body, const Inertia* payload) noexcept;
 
