@@ -459,6 +459,11 @@ long peak_rss_kb_of(const std::string& args) {
 }
 
 TEST_F(Replay, LongLogReplaysInTheMemoryOfAShortOne) {
+#if defined(__SANITIZE_ADDRESS__)
+  // ASan's quarantine keeps freed blocks (up to 256 MB) and its shadow grows with the traffic:
+  // the peak RSS measures the sanitizer, not the replay. The plain build runs this test.
+  GTEST_SKIP() << "peak RSS is meaningless under AddressSanitizer";
+#endif
   // 3.6 M rows (1 h at 1 kHz, ~2.8 GB): opt in with EXTWRENCH_LONG_TESTS=1 (README). By default
   // the same check runs on 200 k rows, still 3× the 1-minute log.
   const bool long_run = std::getenv("EXTWRENCH_LONG_TESTS") != nullptr;
