@@ -33,6 +33,7 @@ struct Scenario {
   bool force_in_world = false;  ///< F_L is then constant in the world frame
   double speed = 1.0;           ///< scales the trajectory's frequencies
   double tau_min = 1.0;         ///< detection threshold (default of DetectionOptions)
+  double kp = 100.0, kd = 20.0; ///< the tracking controller's PD gains [1/s², 1/s]
 };
 
 struct Sample {
@@ -54,6 +55,8 @@ void run(const Scenario& s, Visit&& visit) {
   tracker.amplitude = (VectorX(7) << 0.8, 0.6, 0.8, 0.7, 0.9, 0.8, 1.0).finished();
   tracker.q0 = (VectorX(7) << 0, 0.6, 0, -0.9, 0, 0.7, 0).finished();
   tracker.frequency *= s.speed;
+  tracker.kp = s.kp;
+  tracker.kd = s.kd;
   arm.q = tracker.q0;
   {
     VectorX qd, dqd, ddqd;
@@ -119,9 +122,12 @@ Vector3 tangential_force(SeededRng& rng, const Vector3& lever_dir, double magnit
 }
 
 // A constant (world-frame) force starts on a moving arm: the wrench error decays with e^{−K t}
-// (SPEC §2: ṙ = K (τ_ext − r)) and is < 1 % of ‖F‖ by 8/K s. What remains is the residual's
-// lag behind the slowly varying τ_ext = J(q)ᵀ F (∝ speed / K), so the arm moves at a moderate
-// pace here (joint speeds ≤ 0.4 rad/s).
+// (SPEC §2: ṙ = K (τ_ext − r)) and is < 1 % of ‖F‖ by 8/K s. The law holds for a constant
+// τ_ext; on a moving arm τ_ext = J(q)ᵀ F drifts and r lags it by ≈ (1/K) dτ_ext/dt. So the arm
+// is position-controlled stiffly (ω = 100 rad/s, like an industrial arm): with the soft default
+// gains (ω = 10 rad/s) the push deflects the arm over ~0.3 s, τ_ext changes with q while the
+// filter settles, and that transient of the simulated controller, not the observer, dominated
+// (1.2–1.4 % at K = 50). The trajectory's own drift leaves ≈ 0.6 % at K = 50, 0.3 % at K = 100.
 TEST(EstimatorLoop, ForceErrorDecaysLikeTheFirstOrderLawAndIsBelowOnePercentByEightOverK) {
   for (SensorType sensor : {SensorType::kNone, SensorType::kForceTorque}) {
     for (double gain : {50.0, 100.0, 200.0}) {
@@ -137,8 +143,9 @@ TEST(EstimatorLoop, ForceErrorDecaysLikeTheFirstOrderLawAndIsBelowOnePercentByEi
       s.tau_min = 0.1;  // isolation must find link 7 (no sensor needs rank J_l = 6)
       s.t_on = 0.5;
       s.t_off = s.t_end = 0.5 + 8 / gain + 0.3;
-      // Known shortfall: at K = 50 the lag floor is ~1.2 % on this trajectory (1 % asked).
-      const double floor = gain < 100 ? 1.5e-2 : 1e-2;
+      s.kp = 1e4;
+      s.kd = 200;
+      const double floor = 1e-2;  // the acceptance bound, for every K
       double err_first = kNaN, worst_late = 0.0, worst_law_excess = 0.0;
       run(s, [&](const Sample& m) {
         if (!m.in_contact) return;
@@ -147,8 +154,8 @@ TEST(EstimatorLoop, ForceErrorDecaysLikeTheFirstOrderLawAndIsBelowOnePercentByEi
         if (std::isnan(err) && since >= 2 / gain) err = 1e9;  // no estimate: a failure, not a pass
         if (std::isnan(err_first) && since >= 1 / gain - 1e-9) err_first = err;
         if (since >= 1 / gain) {
-          // e(t) ≤ e(1/K) e^{−K (t − 1/K)}, plus a floor of 1 % for the lag behind the drift of
-          // τ_ext = J(q)ᵀ F (∝ speed / K)
+          // e(t) ≤ e(1/K) e^{−K (t − 1/K)}, plus the 1 % allowed for the lag behind the drift
+          // of τ_ext = J(q)ᵀ F (∝ speed / K)
           const double law = 1.3 * err_first * std::exp(-gain * (since - 1 / gain)) + floor;
           worst_law_excess = std::max(worst_law_excess, err - law);
         }
