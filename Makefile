@@ -32,11 +32,12 @@ demo: build
 bench:
 	cmake -S . -B $(BENCH_BUILD) -DCMAKE_BUILD_TYPE=Release -DEXTWRENCH_BUILD_BENCHMARKS=ON \
 	  -DEXTWRENCH_BUILD_TESTS=OFF
-	cmake --build $(BENCH_BUILD) -j $(JOBS) --target extwrench_bench extwrench_cli
+	cmake --build $(BENCH_BUILD) -j $(JOBS) --target extwrench_bench extwrench_cli extwrench_make_log
 	mkdir -p $(BUILD)
 	$(BENCH_BUILD)/benchmarks/extwrench_bench --benchmark_out=$(BUILD)/bench.json \
 	  --benchmark_out_format=json --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 	python3 benchmarks/ratios.py $(BUILD)/bench.json
+	bash benchmarks/replay_long_log.sh $(BENCH_BUILD) $(BUILD)/long_log
 
 format:
 	clang-format -i $$(git ls-files '*.hpp' '*.cpp')
