@@ -18,6 +18,7 @@ namespace {
 
 constexpr std::size_t kReadChunk = std::size_t{1} << 18;   // 256 KiB per read()
 constexpr std::size_t kWriteChunk = std::size_t{1} << 20;  // flush the writer every 1 MiB
+constexpr std::size_t kMaxNumberChars = 32;  // the shortest form of a double: at most 24 chars
 constexpr std::size_t kShownCellChars = 40;                // longer cells are cut in messages
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
@@ -314,23 +315,44 @@ std::string CsvWriter::format(double value) {
   return s;
 }
 
-void CsvWriter::separator() {
-  if (cells_in_row_ > 0) buffer_.push_back(',');
-  ++cells_in_row_;
+char* CsvWriter::room(std::size_t bytes) {
+  if (size_ + bytes > capacity_) grow(size_ + bytes);
+  return buffer_.get() + size_;
+}
+
+void CsvWriter::grow(std::size_t needed) {
+  // Whole rows are flushed, so a row longer than the chunk grows the buffer instead.
+  const std::size_t capacity = std::max({needed, 2 * capacity_, kWriteChunk + 4096});
+  auto bigger = std::make_unique_for_overwrite<char[]>(capacity);
+  if (size_ > 0) std::memcpy(bigger.get(), buffer_.get(), size_);
+  buffer_ = std::move(bigger);
+  capacity_ = capacity;
+}
+
+char* CsvWriter::separator(std::size_t bytes) {
+  char* p = room(bytes + 1);
+  if (cells_in_row_++ > 0) {
+    *p++ = ',';
+    ++size_;
+  }
+  return p;
 }
 
 CsvWriter& CsvWriter::add(double value) {
-  separator();
-  if (!std::isnan(value)) append(buffer_, value);
+  char* p = separator(kMaxNumberChars);
+  if (!std::isnan(value)) {
+    const auto [end, ec] = std::to_chars(p, p + kMaxNumberChars, value);
+    (void)ec;  // cannot fail with 32 characters
+    size_ += static_cast<std::size_t>(end - p);
+  }
   return *this;
 }
 
 CsvWriter& CsvWriter::add(long long value) {
-  separator();
-  std::array<char, 24> text{};
-  const auto [ptr, ec] = std::to_chars(text.data(), text.data() + text.size(), value);
+  char* p = separator(kMaxNumberChars);
+  const auto [end, ec] = std::to_chars(p, p + kMaxNumberChars, value);
   (void)ec;
-  buffer_.append(text.data(), ptr);
+  size_ += static_cast<std::size_t>(end - p);
   return *this;
 }
 
@@ -338,47 +360,54 @@ CsvWriter& CsvWriter::add(int value) { return add(static_cast<long long>(value))
 CsvWriter& CsvWriter::add(std::size_t value) { return add(static_cast<long long>(value)); }
 
 CsvWriter& CsvWriter::add(std::string_view text) {
-  separator();
-  const bool needs_quotes =
-      text.find_first_of(",\"\r\n") != std::string_view::npos ||
-      (!text.empty() && (is_blank(text.front()) || is_blank(text.back())));
+  bool needs_quotes = !text.empty() && (is_blank(text.front()) || is_blank(text.back()));
+  for (std::size_t i = 0; i < text.size() && !needs_quotes; ++i) {
+    const char c = text[i];
+    needs_quotes = c == ',' || c == '"' || c == '\r' || c == '\n';
+  }
   if (!needs_quotes) {
-    buffer_.append(text);
+    char* p = separator(text.size());
+    if (!text.empty()) std::memcpy(p, text.data(), text.size());
+    size_ += text.size();
     return *this;
   }
-  buffer_.push_back('"');
+  char* p = separator(2 * text.size() + 2);  // every character a quote, doubled
+  const char* const begin = p;
+  *p++ = '"';
   for (const char c : text) {
-    if (c == '"') buffer_.push_back('"');
-    buffer_.push_back(c);
+    if (c == '"') *p++ = '"';
+    *p++ = c;
   }
-  buffer_.push_back('"');
+  *p++ = '"';
+  size_ += static_cast<std::size_t>(p - begin);
   return *this;
 }
 
 CsvWriter& CsvWriter::add_empty() {
-  separator();
+  (void)separator(0);
   return *this;
 }
 
 void CsvWriter::end_row() {
   if (cells_in_row_ != header_.size()) {
     const std::size_t got = cells_in_row_;
-    buffer_.resize(row_start_);  // drop the incomplete row
+    size_ = row_start_;  // drop the incomplete row
     cells_in_row_ = 0;
     throw Error(name_ + ": internal error: a row of " + std::to_string(got) + " cells for " +
                 std::to_string(header_.size()) + " columns");
   }
-  buffer_.push_back('\n');
+  *room(1) = '\n';
+  ++size_;
   cells_in_row_ = 0;
-  if (buffer_.size() >= kWriteChunk) flush();
-  row_start_ = buffer_.size();
+  if (size_ >= kWriteChunk) flush();
+  row_start_ = size_;
 }
 
 void CsvWriter::flush() {
   if (out_ == nullptr) return;
-  if (!buffer_.empty()) {
-    out_->write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
-    buffer_.clear();
+  if (size_ > 0) {
+    out_->write(buffer_.get(), static_cast<std::streamsize>(size_));
+    size_ = 0;
     row_start_ = 0;
   }
   out_->flush();

@@ -240,7 +240,7 @@ std::vector<std::string> estimates_columns(int n) {
 }  // namespace
 
 EstimatesWriter::EstimatesWriter(const std::filesystem::path& path, int n)
-    : n_(n), csv_(path, estimates_columns(n)) {}
+    : n_(n), csv_(path, estimates_columns(n)), cached_status_(describe_flags(cached_flags_)) {}
 
 std::string EstimatesWriter::status_text(const ContactEstimate& e) {
   if (!e.status.ok()) {
@@ -266,7 +266,15 @@ void EstimatesWriter::write(const ContactEstimate& e) {
   for (int k = 0; k < 3; ++k) csv_.add(e.moment_W[k]);
   for (int k = 0; k < 3; ++k) csv_.add(e.point_W[k]);
   for (int k = 0; k < 3; ++k) csv_.add(e.line_point_W[k]);
-  csv_.add(std::string_view(status_text(e)));
+  if (e.status.ok()) {
+    if (e.flags != cached_flags_) {
+      cached_flags_ = e.flags;
+      cached_status_ = describe_flags(e.flags);
+    }
+    csv_.add(std::string_view(cached_status_));
+  } else {
+    csv_.add(std::string_view(status_text(e)));
+  }
   csv_.add(e.condition_number);
   for (int i = 0; i < n_; ++i) {
     csv_.add(e.residual.size() == n_ ? e.residual[i] : std::nan(""));

@@ -145,14 +145,19 @@ class CsvWriter {
   static void append(std::string& out, double value);
 
  private:
-  void separator();
-  void write_row_text(std::string_view text);
+  char* room(std::size_t bytes);  // the end of the buffer, with `bytes` free after it
+  void grow(std::size_t needed);
+  char* separator(std::size_t bytes);  // room() for the ',' (if any) and `bytes` after it
 
   std::unique_ptr<std::ofstream> owned_stream_;
   std::ostream* out_ = nullptr;
   std::string name_;
   std::vector<std::string> header_;
-  std::string buffer_;
+  // Cells are formatted straight into this buffer (std::to_chars, no temporaries); it goes out
+  // in one write() per ~1 MiB of whole rows.
+  std::unique_ptr<char[]> buffer_;
+  std::size_t capacity_ = 0;
+  std::size_t size_ = 0;
   std::size_t row_start_ = 0;     // where the current row begins in buffer_
   std::size_t cells_in_row_ = 0;
 };

@@ -2,6 +2,7 @@
 // them (the simulator's output), and the estimates file of `extwrench estimate`.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -98,6 +99,9 @@ class EstimatesWriter {
  private:
   int n_;
   CsvWriter csv_;
+  // The status text of the last ok row: flags change rarely, describe_flags() allocates.
+  std::uint32_t cached_flags_ = 0;
+  std::string cached_status_;
 };
 
 }  // namespace extwrench
