@@ -83,7 +83,9 @@ class CsvReader {
  private:
   void read_header();
   bool read_line();
+  void refill();
   void split_line();
+  void split_quoted_line();
   [[noreturn]] void fail_number(int column, std::string_view reason) const;
   double parse(int column, bool allow_missing) const;
 
@@ -93,14 +95,14 @@ class CsvReader {
   std::vector<std::string> header_;
   std::unordered_map<std::string, int> column_index_;
 
-  // Read buffer: lines are cut out of it with memchr rather than std::getline, which is the
-  // hot path when replaying long logs.
+  // Read buffer: lines are found with memchr and parsed where they lie (no copy); a line cut by
+  // the end of the buffer is moved to its front before the next read.
   std::vector<char> buffer_;
   std::size_t buffer_pos_ = 0;
   std::size_t buffer_end_ = 0;
   bool eof_ = false;
 
-  std::string line_;                   // the current line (CR stripped)
+  std::string_view line_;              // the current line in buffer_ (CR stripped)
   std::string unquoted_;               // storage for quoted cells with "" escapes
   std::vector<std::string_view> cells_;
   std::size_t next_line_ = 1;          // number of the next line to be read
