@@ -104,8 +104,45 @@ void momentum_terms_no_kinematics(const Model& model, Data& data,
 
 void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq) {
-  forward_kinematics(model, data, q);
-  momentum_terms_no_kinematics(model, data, dq);
+  // As momentum_terms_no_kinematics, with each body's momentum taken about its CoM with the
+  // constant body-axes inertia I_c: no world inertia R I_c R^T is formed (see rnea).
+  detail::poses_and_subspaces(model, data, q);
+  const int nb = model.num_bodies();
+  const Vector3& g = model.gravity;
+  data.v[0].setZero();
+  data.f[0].setZero();  // link 0 is at rest
+  data.h[0].setZero();
+  data.composite_mass[0] = model.bodies[0].inertia.mass;
+  data.composite_first_moment[0] = model.bodies[0].inertia.mass * model.bodies[0].inertia.com;
+  for (int i = 1; i < nb; ++i) {
+    data.v[i] = data.v[model.parents[i]] + data.S[i] * dq[i - 1];
+    const Inertia& inertia = model.bodies[i].inertia;
+    const Pose& X = data.X_WB[i];
+    const Vector3 c = X.act(inertia.com);
+    const auto w = detail::ang(data.v[i]);
+    // h_i about the world origin: [m v_c; I_c,W w + c x m v_c], v_c the velocity of the CoM.
+    const Vector3 L = inertia.mass * (detail::lin(data.v[i]) + w.cross(c));
+    const Vector3 w_B = X.rotation.transpose() * w;
+    const Vector3 Iw_B = inertia.inertia_com * w_B;
+    data.f[i].head<3>() = L;
+    data.f[i].tail<3>().noalias() = X.rotation * Iw_B;
+    data.f[i].tail<3>() += c.cross(L);
+    data.h[i] = data.f[i];  // f accumulates H_i = sum of h_k over sub(i) below
+    data.composite_mass[i] = inertia.mass;
+    data.composite_first_moment[i] = inertia.mass * c;
+  }
+  for (int i = nb - 1; i > 0; --i) {
+    const int p = model.parents[i];
+    const Vector6& s = data.S[i];
+    data.momentum[i - 1] = s.dot(data.f[i]);  // p_i = S_i^T H_i
+    data.coriolis_transpose_dq[i - 1] = -s.dot(detail::cross_force(data.v[p], data.f[i]));
+    const double mc = data.composite_mass[i];
+    const Vector3& hc = data.composite_first_moment[i];
+    data.gravity_torque[i - 1] = -(s.head<3>().dot(mc * g) + s.tail<3>().dot(hc.cross(g)));
+    data.f[p] += data.f[i];
+    data.composite_mass[p] += mc;
+    data.composite_first_moment[p] += hc;
+  }
 }
 
 bool forward_dynamics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,

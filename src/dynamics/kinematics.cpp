@@ -5,14 +5,13 @@
 namespace extwrench {
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  detail::poses_and_subspaces(model, data, q);
+  world_mass_properties(model, data);
+}
+
+void world_mass_properties(const Model& model, Data& data) {
   const int nb = model.num_bodies();
-  data.X_WB[0] = Pose{};
-  data.S[0].setZero();
   for (int i = 0; i < nb; ++i) {
-    if (i > 0) {
-      detail::joint_kinematics(model.joints[i], data.X_WB[model.parents[i]], q[i - 1],
-                               data.X_WB[i], data.S[i]);
-    }
     // Mass properties about the world origin: h = m c_W, I_O = R I_c R^T + m (|c|^2 1 - c c^T).
     const Inertia& inertia = model.bodies[i].inertia;
     const Pose& X = data.X_WB[i];

@@ -47,7 +47,8 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
   }
   for (int i = 1; i < nb; ++i) {
     const int p = model.parents[i];
-    detail::joint_kinematics(model.joints[i], data.X_WB[p], q[i - 1], data.X_WB[i], data.S[i]);
+    detail::joint_kinematics(model.joints[i], data.placement_axis[i], data.placement_sign[i],
+                             data.X_WB[p], q[i - 1], data.X_WB[i], data.S[i]);
     const Vector6& s = data.S[i];
     const Vector6 vj = s * dq[i - 1];
     data.v[i] = data.v[p] + vj;

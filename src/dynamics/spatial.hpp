@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "extwrench/core/types.hpp"
+#include "extwrench/dynamics/data.hpp"
 #include "extwrench/model/model.hpp"
 
 namespace extwrench::detail {
@@ -99,13 +100,26 @@ inline void rotate_about_axis(const Matrix3& R, const Vector3& axis, double s, d
 }
 
 /// Pose X_WB of body i and its joint's motion subspace S_i (world, about the world origin),
-/// from the parent's pose X_WP and q_i.
-inline void joint_kinematics(const Joint& joint, const Pose& X_WP, double qi, Pose& X_WB,
+/// from the parent's pose X_WP and q_i (placement_*: Data's classification of the placement).
+inline void joint_kinematics(const Joint& joint, const std::array<int, 3>& placement_axis,
+                             const Vector3& placement_sign, const Pose& X_WP, double qi, Pose& X_WB,
                              Vector6& S) {
-  const Matrix3 R_WJ = X_WP.rotation * joint.placement.rotation;  // joint frame at q = 0
+  Matrix3 R_WJ;  // joint frame at q = 0
+  if (placement_axis[0] >= 0) {
+    for (int k = 0; k < 3; ++k) R_WJ.col(k) = placement_sign[k] * X_WP.rotation.col(placement_axis[k]);
+  } else {
+    R_WJ.noalias() = X_WP.rotation * joint.placement.rotation;
+  }
   X_WB.translation.noalias() = X_WP.rotation * joint.placement.translation;
   X_WB.translation += X_WP.translation;
-  const Vector3 axis_W = R_WJ * joint.axis;
+  // The URDF/DH norm is a coordinate axis: then axis_W is a column of R_WJ, no product.
+  const Vector3& a = joint.axis;
+  Vector3 axis_W;
+  if (a.x() == 0.0 && a.y() == 0.0 && a.z() == 1.0) {
+    axis_W = R_WJ.col(2);
+  } else {
+    axis_W.noalias() = R_WJ * a;
+  }
   if (joint.type == JointType::kRevolute) {
     rotate_about_axis(R_WJ, joint.axis, std::sin(qi), std::cos(qi), X_WB.rotation);
     // Revolute about axis z through O_i: velocity of the body point at the world origin
@@ -115,6 +129,18 @@ inline void joint_kinematics(const Joint& joint, const Pose& X_WP, double qi, Po
     X_WB.rotation = R_WJ;
     X_WB.translation += axis_W * qi;
     S << axis_W, Vector3::Zero();
+  }
+}
+
+/// Poses (data.X_WB) and motion subspaces (data.S) of all bodies: forward_kinematics without
+/// the world-frame mass properties.
+inline void poses_and_subspaces(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  const int nb = model.num_bodies();
+  data.X_WB[0] = Pose{};
+  data.S[0].setZero();
+  for (int i = 1; i < nb; ++i) {
+    joint_kinematics(model.joints[i], data.placement_axis[i], data.placement_sign[i],
+                     data.X_WB[model.parents[i]], q[i - 1], data.X_WB[i], data.S[i]);
   }
 }
 

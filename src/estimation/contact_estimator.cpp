@@ -30,71 +30,121 @@ struct DlsInfo {
   double condition = kNaN;
 };
 
-/// The extreme eigenvalues (λ_min, λ_max) of a symmetric R×R matrix A, without eigenvectors:
-/// Householder reduction to a tridiagonal T (same spectrum), then Laguerre's iteration on
-/// det(T − x I) from a Gershgorin bound outside the spectrum. For a polynomial with only real
-/// roots Laguerre converges monotonically (cubically near the root) to the root next to the
-/// start, so starting below / above the spectrum yields λ_min / λ_max. The absolute error is
-/// O(ε‖A‖), as for a full symmetric eigensolver; ~10× cheaper than one for R = 6.
+/// A symmetric positive semi-definite R×R matrix A (here J Jᵀ) reduced to tridiagonal form
+/// T = Qᵀ A Q by R − 2 Householder reflections (lower triangle only), kept so that both the
+/// extreme eigenvalues and the solve with A + μ² I use T: one reduction, no Cholesky of A.
 template <int R>
-void extreme_eigenvalues(Eigen::Matrix<double, R, R> A, double& lambda_min, double& lambda_max) noexcept {
-  // Householder tridiagonalisation: A ← H A H column by column (both triangles kept).
-  for (int k = 0; k + 2 < R; ++k) {
-    double tail2 = 0.0;
-    for (int i = k + 2; i < R; ++i) tail2 += A(i, k) * A(i, k);
-    if (tail2 == 0.0) continue;  // already tridiagonal in this column
-    const double x0 = A(k + 1, k);
-    const double alpha2 = x0 * x0 + tail2;
-    const double alpha = x0 >= 0.0 ? -std::sqrt(alpha2) : std::sqrt(alpha2);
-    Eigen::Matrix<double, R, 1> v = Eigen::Matrix<double, R, 1>::Zero();
-    for (int i = k + 1; i < R; ++i) v[i] = A(i, k);
-    v[k + 1] -= alpha;
-    const double vv = tail2 + v[k + 1] * v[k + 1];
-    const double beta = 2.0 / vv;  // H = I − β v vᵀ
-    // H A H = A − v wᵀ − w vᵀ with p = β A v, w = p − (β vᵀp / 2) v.
-    Eigen::Matrix<double, R, 1> pv = beta * (A * v);
-    const double K = 0.5 * beta * v.dot(pv);
-    pv -= K * v;
-    A.noalias() -= v * pv.transpose();
-    A.noalias() -= pv * v.transpose();
+struct Tridiagonal {
+  double diag[R];     ///< T_ii
+  double sub[R];      ///< T_i,i−1 (sub[0] unused)
+  double v[R][R];     ///< Householder vector k on rows k+1..R−1
+  double beta[R];     ///< H_k = I − β_k v_k v_kᵀ (β_k = 0: identity)
+
+  explicit Tridiagonal(Eigen::Matrix<double, R, R> A) noexcept {
+    for (int k = 0; k + 2 < R; ++k) {
+      double tail2 = 0.0;
+      for (int i = k + 2; i < R; ++i) tail2 += A(i, k) * A(i, k);
+      beta[k] = 0.0;
+      if (tail2 == 0.0) continue;  // already tridiagonal in this column
+      const double x0 = A(k + 1, k);
+      const double alpha = x0 >= 0.0 ? -std::sqrt(x0 * x0 + tail2) : std::sqrt(x0 * x0 + tail2);
+      double* vk = v[k];
+      for (int i = k + 1; i < R; ++i) vk[i] = A(i, k);
+      vk[k + 1] -= alpha;
+      const double b = 2.0 / (tail2 + vk[k + 1] * vk[k + 1]);
+      beta[k] = b;
+      // H A H = A − v wᵀ − w vᵀ on the trailing block, w = p − (β vᵀp / 2) v, p = β A v.
+      double w[R];
+      for (int i = k + 1; i < R; ++i) {
+        double sum = 0.0;
+        for (int j = k + 1; j < R; ++j) sum += (j <= i ? A(i, j) : A(j, i)) * vk[j];
+        w[i] = b * sum;
+      }
+      double vp = 0.0;
+      for (int i = k + 1; i < R; ++i) vp += vk[i] * w[i];
+      const double half = 0.5 * b * vp;
+      for (int i = k + 1; i < R; ++i) w[i] -= half * vk[i];
+      for (int j = k + 1; j < R; ++j) {
+        for (int i = j; i < R; ++i) A(i, j) -= vk[i] * w[j] + w[i] * vk[j];
+      }
+      A(k + 1, k) = alpha;
+    }
+    for (int i = 0; i < R; ++i) {
+      diag[i] = A(i, i);
+      sub[i] = i > 0 ? A(i, i - 1) : 0.0;
+    }
   }
-  double a[R];
-  double b2[R];  // b2[i] = T(i, i−1)², b2[0] unused
+
+  /// x ← (A + shift I)⁻¹ x = Q (T + shift I)⁻¹ Qᵀ x; false when T + shift I is not (numerically)
+  /// positive definite. T + shift I = L D Lᵀ with a unit bidiagonal L: stable without pivoting
+  /// for a positive definite T.
+  bool solve(double shift, double* x) const noexcept {
+    for (int k = 0; k + 2 < R; ++k) reflect(k, x);  // Qᵀ x = H_{R−3} … H_0 x
+    double d[R];
+    double l[R];
+    d[0] = diag[0] + shift;
+    if (!(d[0] > 0.0)) return false;
+    for (int i = 1; i < R; ++i) {
+      l[i] = sub[i] / d[i - 1];
+      d[i] = diag[i] + shift - l[i] * sub[i];
+      if (!(d[i] > 0.0)) return false;
+    }
+    for (int i = 1; i < R; ++i) x[i] -= l[i] * x[i - 1];
+    x[R - 1] /= d[R - 1];
+    for (int i = R - 2; i >= 0; --i) x[i] = x[i] / d[i] - l[i + 1] * x[i + 1];
+    for (int k = R - 3; k >= 0; --k) reflect(k, x);  // Q y = H_0 … H_{R−3} y
+    return true;
+  }
+
+ private:
+  void reflect(int k, double* x) const noexcept {
+    if (beta[k] == 0.0) return;
+    double dot = 0.0;
+    for (int i = k + 1; i < R; ++i) dot += v[k][i] * x[i];
+    dot *= beta[k];
+    for (int i = k + 1; i < R; ++i) x[i] -= dot * v[k][i];
+  }
+};
+
+/// The extreme eigenvalues (λ_min, λ_max) of the positive semi-definite matrix reduced to T, by
+/// Laguerre's iteration on det(T − x I). For a polynomial with only real roots Laguerre
+/// converges monotonically (cubically near the root) to the root next to the start, so starting
+/// below / above the spectrum yields λ_min / λ_max: from 0 (PSD) and from min(trace, Gershgorin
+/// bound), both close to their ends when J is ill-conditioned, the case that matters. The
+/// absolute error is O(ε‖A‖), as for a full symmetric eigensolver, at a fraction of its cost.
+template <int R>
+void extreme_eigenvalues(const Tridiagonal<R>& T, double& lambda_min, double& lambda_max) noexcept {
+  double b2[R];  // T_i,i−1²
+  double trace = 0.0;
+  double gershgorin = -kInf;
   for (int i = 0; i < R; ++i) {
-    a[i] = A(i, i);
-    b2[i] = i > 0 ? A(i, i - 1) * A(i, i - 1) : 0.0;
+    b2[i] = T.sub[i] * T.sub[i];
+    trace += T.diag[i];
+    double radius = 0.0;
+    if (i > 0) radius += std::abs(T.sub[i]);
+    if (i + 1 < R) radius += std::abs(T.sub[i + 1]);
+    gershgorin = std::max(gershgorin, T.diag[i] + radius);
   }
-  double lo = kInf;
-  double hi = -kInf;
-  for (int i = 0; i < R; ++i) {
-    double rad = 0.0;
-    if (i > 0) rad += std::abs(A(i, i - 1));
-    if (i + 1 < R) rad += std::abs(A(i + 1, i));
-    lo = std::min(lo, a[i] - rad);
-    hi = std::max(hi, a[i] + rad);
-  }
-  const double scale = std::max(std::abs(lo), std::abs(hi));
-  // Both ends iterated together (independent dependency chains overlap in the CPU).
-  double x[2] = {lo, hi};
+  const double hi = std::min(trace, gershgorin);
+  const double scale = std::abs(hi);
+  double x[2] = {0.0, hi};
   const double direction[2] = {1.0, -1.0};  // from below (λ_min), from above (λ_max)
   bool done[2] = {false, R == 1};
   for (int it = 0; it < 100 && !(done[0] && done[1]); ++it) {
+    // Both ends evaluated unconditionally: two independent dependency chains that overlap.
+    double step[2];
+    bool stop[2];
     for (int e = 0; e < 2; ++e) {
-      if (done[e]) continue;
       // det(T − xI) and its first two x-derivatives by the three-term recurrence.
-      double p0 = 1.0, d0 = 0.0, s0 = 0.0;              // k − 2
-      double p1 = a[0] - x[e], d1 = -1.0, s1 = 0.0;     // k − 1
+      double p0 = 1.0, d0 = 0.0, s0 = 0.0;                // k − 2
+      double p1 = T.diag[0] - x[e], d1 = -1.0, s1 = 0.0;  // k − 1
       for (int k = 1; k < R; ++k) {
-        const double c = a[k] - x[e];
+        const double c = T.diag[k] - x[e];
         const double p = c * p1 - b2[k] * p0;
         const double d = c * d1 - p1 - b2[k] * d0;
         const double s = c * s1 - 2.0 * d1 - b2[k] * s0;
         p0 = p1; d0 = d1; s0 = s1;
         p1 = p; d1 = d; s1 = s;
-      }
-      if (p1 == 0.0 || !std::isfinite(p1)) {
-        done[e] = true;
-        continue;
       }
       const double inv_p = 1.0 / p1;
       const double G = d1 * inv_p;          // Σ 1/(x − λ_i)
@@ -102,37 +152,40 @@ void extreme_eigenvalues(Eigen::Matrix<double, R, R> A, double& lambda_min, doub
       const double disc = std::max((R - 1) * (R * H - G * G), 0.0);
       // Laguerre's step toward the spectrum (the larger-magnitude denominator).
       const double den = std::abs(G) + std::sqrt(disc);
-      if (!(den > 0.0)) {
+      step[e] = R / den;
+      // x is an eigenvalue (e.g. 0 for a rank-deficient J), or round-off took over.
+      stop[e] = p1 == 0.0 || !std::isfinite(p1) || !(den > 0.0);
+    }
+    for (int e = 0; e < 2; ++e) {
+      if (done[e]) continue;
+      if (stop[e]) {
         done[e] = true;
         continue;
       }
-      const double step = R / den;
-      x[e] += direction[e] * step;
+      x[e] += direction[e] * step[e];
       // Converged (cubically: the remaining error is far below the step) or at round-off level.
-      done[e] = !(step > 1e-14 * std::abs(x[e]) && step > 1e-15 * scale);
+      done[e] = !(step[e] > 1e-14 * std::abs(x[e]) && step[e] > 1e-15 * scale);
     }
   }
   lambda_min = x[0];
   lambda_max = R > 1 ? x[1] : x[0];
 }
 
-/// Solves Jᵀ x = b in the damped least-squares sense (J: R×n; the columns of joints beyond the
-/// contact link are zero, so they drop out). x = (J Jᵀ + μ² I)⁻¹ J b with the damping law of
-/// the header: σ_min, σ_max from the extreme eigenvalues of the R×R matrix J Jᵀ, then one
-/// Cholesky solve (fixed size: no allocation). The normal equations square κ: with κ ≤ 1e3 the
-/// relative error stays ~1e-10.
+/// Solves Jᵀ x = b in the damped least-squares sense, J: R×n of which only the first `cols`
+/// columns (the joints up to the contact link) can be non-zero. x = (J Jᵀ + μ² I)⁻¹ J b with
+/// the damping law of the header: σ_min, σ_max from the extreme eigenvalues of the R×R matrix
+/// J Jᵀ, the solve through the same tridiagonal form (fixed size: no allocation). The normal
+/// equations square κ: with κ ≤ 1e3 the relative error stays ~1e-10.
 template <int R, typename Derived>
-DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, const VectorX& b, const SolverOptions& opt,
-                     Eigen::Matrix<double, R, 1>& x) noexcept {
-  using MatR = Eigen::Matrix<double, R, R>;
-  using VecR = Eigen::Matrix<double, R, 1>;
-  MatR A;
-  A.noalias() = J * J.transpose();
-  VecR Jb;
-  Jb.noalias() = J * b;
+DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, int cols, const VectorX& b,
+                     const SolverOptions& opt, Eigen::Matrix<double, R, 1>& x) noexcept {
+  Eigen::Matrix<double, R, R> A;
+  A.noalias() = J.leftCols(cols) * J.leftCols(cols).transpose();
+  x.noalias() = J.leftCols(cols) * b.head(cols);
+  const Tridiagonal<R> T(A);
   double l_min = 0.0;
   double l_max = 0.0;
-  extreme_eigenvalues<R>(A, l_min, l_max);  // σ_min², σ_max²
+  extreme_eigenvalues<R>(T, l_min, l_max);  // σ_min², σ_max²
   const double s_max = std::sqrt(std::max(l_max, 0.0));
   const double s_min = std::sqrt(std::max(l_min, 0.0));
   DlsInfo info;
@@ -141,14 +194,11 @@ DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, const VectorX& b, cons
   const double eps = s_max / opt.max_condition;  // ε = σ_max / κ_max
   const double mu2 = s_min < eps ? eps * eps - s_min * s_min : 0.0;
   info.damped = mu2 > 0.0;
-  if (!info.rank_ok) {
+  // rank_ok ⇒ σ_min > 0 ⇒ J Jᵀ + μ² I is positive definite (round-off checked by the solve).
+  if (!info.rank_ok || !T.solve(mu2, x.data())) {
+    info.rank_ok = false;
     x.setConstant(kNaN);  // unused by the callers: the wrench is unobservable
-    return info;
   }
-  // rank_ok ⇒ σ_min > 0 ⇒ J Jᵀ + μ² I is positive definite.
-  A.diagonal().array() += mu2;
-  const Eigen::LLT<MatR> llt(A);
-  x = llt.solve(Jb);
   return info;
 }
 
@@ -318,6 +368,9 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
                         options_.acceleration == AccelerationRoute::kDifferentiation;
   out_.status = Status::success();
   tau_eff_ = tau - observer_.friction_torque();  // τ − τ_f
+  // The observer's pass computed the poses; the CRBA and RNEA below also need the world-frame
+  // mass properties (case E, no sensor, does not).
+  if (need_ddq) world_mass_properties(model, data);
   if (options_.acceleration == AccelerationRoute::kDifferentiation) {
     // (a) q̈̂: backward difference of q̇ through a first-order low-pass (cutoff f_c), exact
     // discretization for the actual Δt.
@@ -510,7 +563,7 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
       b_ = tau_ext_;
       b_.noalias() -= J_.topRows<3>().transpose() * F;
       Vector3 x;
-      const DlsInfo info = damped_solve<3>(J_.bottomRows<3>(), b_, options_.solver, x);
+      const DlsInfo info = damped_solve<3>(J_.bottomRows<3>(), link, b_, options_.solver, x);
       out_.condition_number = info.condition;
       if (info.rank_ok) {
         M_bar = x;
@@ -520,7 +573,7 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
     } else {
       // E (27): W̄ = (J_lᵀ)# τ̂_1:l, rank J_l = 6 required.
       Vector6 x;
-      const DlsInfo info = damped_solve<6>(J_, tau_ext_, options_.solver, x);
+      const DlsInfo info = damped_solve<6>(J_, link, tau_ext_, options_.solver, x);
       out_.condition_number = info.condition;
       if (info.rank_ok) {
         F = x.head<3>();

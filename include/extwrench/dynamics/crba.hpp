@@ -18,7 +18,9 @@ const MatrixX& coriolis_matrix(const Model& model, Data& data, const Eigen::Ref<
 
 /// Generalized momentum p = B(q) dq into data.momentum and C^T(q, dq) dq = dT/dq into
 /// data.coriolis_transpose_dq, both in O(n) (SPEC 2), and g(q) into data.gravity_torque.
-/// Runs forward_kinematics. These are the three model terms of the momentum residual (4).
+/// Computes the poses and motion subspaces (data.X_WB, data.S) but, unlike forward_kinematics,
+/// not the world-frame mass properties (world_mass_properties adds them). These are the three
+/// model terms of the momentum residual (4).
 void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq);
 /// As momentum_terms, for the q of the last forward_kinematics.

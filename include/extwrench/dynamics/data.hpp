@@ -2,6 +2,7 @@
 // that no algorithm allocates afterwards. One Data per thread; the Model is shared (const).
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -15,6 +16,13 @@ namespace extwrench {
 /// the world origin (a velocity's linear part is that of the body point at the world origin).
 struct Data {
   explicit Data(const Model& model);
+
+  // --- derived from the model once, for the hot path ---
+  /// Joint i's placement rotation when it is a signed permutation (right angles: the DH and
+  /// URDF norm): column k of R = placement_sign[i][k] · e_{placement_axis[i][k]}, so composing
+  /// it with the parent's rotation is a column shuffle, not a 3x3 product. Axis −1: general.
+  std::vector<std::array<int, 3>> placement_axis;
+  std::vector<Vector3> placement_sign;
 
   // --- forward kinematics (forward_kinematics) ---
   std::vector<Pose> X_WB;           ///< pose of each body frame in the world

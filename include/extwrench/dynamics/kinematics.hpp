@@ -9,6 +9,12 @@ namespace extwrench {
 /// properties. q: (n). Every other algorithm calls it first.
 void forward_kinematics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q);
 
+/// The world-frame mass properties of forward_kinematics (data.mass, data.first_moment_W,
+/// data.inertia_O_W) from the poses already in data: for code that ran momentum_terms or rnea
+/// (which compute poses but do not need these) and then wants crba_no_kinematics or
+/// rnea_no_kinematics at the same q.
+void world_mass_properties(const Model& model, Data& data);
+
 /// Pose of a named frame in the world, after forward_kinematics.
 [[nodiscard]] Pose frame_pose(const Model& model, const Data& data, int frame);
 
