@@ -1,0 +1,282 @@
+// replay_log runs in three threads (reader, estimator, writer) handing batches of rows along.
+// Checked against the plain loop it replaced, run here on one thread: the same bytes in
+// estimates.csv, the same error text after the same rows, however the rows fall in batches.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/io/log.hpp"
+#include "extwrench/io/replay.hpp"
+#include "extwrench/io/robot_loader.hpp"
+#include "support/random.hpp"
+
+namespace extwrench {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kPaperArm = fs::path(EXTWRENCH_SOURCE_DIR) / "models" / "paper_arm.urdf";
+// Rows per hand-off between the threads (kBatchRows in replay.cpp); the tests put rows and
+// errors on both sides of batch boundaries and past a full turn of the ring (4 batches).
+constexpr long kBatch = 1024;
+
+class ReplayPipeline : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    robot_ = std::make_unique<RobotDescription>(load_robot(kPaperArm));
+    dir_ = fs::temp_directory_path() / ("extwrench_test_replay_pipeline_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  static void TearDownTestSuite() {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+    robot_.reset();
+  }
+  static std::unique_ptr<RobotDescription> robot_;
+  static fs::path dir_;
+};
+std::unique_ptr<RobotDescription> ReplayPipeline::robot_;
+fs::path ReplayPipeline::dir_;
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_file(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+/// A log of `rows` rows at 1 kHz: smooth joint motion, a noisy F/T reading, a push on link 6
+/// from row 300 (so the estimates go through free, pending and contact).
+void write_log(const fs::path& path, long rows, bool velocity) {
+  LogLayout layout{.n = 7, .velocity = velocity, .force = true, .moment = true, .truth = true, .true_tau_ext = false};
+  LogWriter w(path, layout);
+  test::SeededRng rng(11);
+  sim::Sample s;
+  s.q.resize(7);
+  s.dq.resize(7);
+  s.tau.resize(7);
+  for (long k = 0; k < rows; ++k) {
+    const double t = 0.001 * static_cast<double>(k);
+    for (int i = 0; i < 7; ++i) {
+      s.q[i] = 0.4 * std::sin(0.7 * t + i);
+      s.dq[i] = 0.28 * std::cos(0.7 * t + i);
+      s.tau[i] = 8.0 * std::sin(0.5 * t + i) + rng.uniform(-0.5, 0.5);
+    }
+    s.t = t;
+    const bool push = k >= 300;
+    s.sensor << rng.uniform(-1, 1) + (push ? 15.0 : 0.0), rng.uniform(-1, 1), -170 + rng.uniform(-1, 1),
+        rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1) + (push ? 6.0 : 0.0), rng.uniform(-0.1, 0.1);
+    s.truth.link = push ? "link6" : "";
+    s.truth.body = push ? 6 : -1;
+    s.truth.force << (push ? 15.0 : 0.0), 0, 0;
+    s.truth.point << 0.1, 0.0, 0.6;
+    w.write(s);
+  }
+  w.close();
+}
+
+/// The log with data row `row` (0-based) replaced by `text` (a malformed row).
+void corrupt_row(const fs::path& from, const fs::path& to, long row, const std::string& text) {
+  std::istringstream in(read_file(from));
+  std::string out, line;
+  for (long k = -1; std::getline(in, line); ++k) out += (k == row ? text : line) + "\n";
+  write_file(to, out);
+}
+
+/// The same data row with cell `cell` (0-based) replaced.
+std::string row_with_cell(const fs::path& log, long row, int cell, const std::string& value) {
+  std::istringstream in(read_file(log));
+  std::string line;
+  for (long k = -1; std::getline(in, line) && k < row; ++k) {
+  }
+  std::vector<std::string> cells;
+  std::stringstream s(line);
+  for (std::string c; std::getline(s, c, ',');) cells.push_back(c);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  cells.at(static_cast<std::size_t>(cell)) = value;
+  std::string joined;
+  for (std::size_t i = 0; i < cells.size(); ++i) joined += (i ? "," : "") + cells[i];
+  return joined;
+}
+
+struct Outcome {
+  std::string error;      // empty when it succeeded
+  std::string estimates;  // the bytes of estimates.csv
+};
+
+/// The loop replay_log ran before it was split into threads: one row read, estimated and
+/// written after the other, on the calling thread.
+Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& options, const fs::path& log,
+                   const fs::path& out_dir) {
+  fs::create_directories(out_dir);
+  Outcome o;
+  try {
+    LogReader reader(log, robot.model);
+    ContactEstimator estimator(robot.model, robot.geometry, options);
+    const int n = robot.model.nq();
+    EstimatesWriter writer(out_dir / "estimates.csv", n);
+    sim::Sample s;
+    bool started = false;
+    while (reader.next(s)) {
+      if (!started) {
+        ContactEstimate first;
+        first.t = s.t;
+        first.residual = VectorX::Zero(n);
+        first.status = estimator.reset(s.t, s.q, s.dq, s.tau);
+        started = first.status.ok();
+        writer.write(first);
+      } else {
+        (void)(options.sensor.type == SensorType::kNone ? estimator.update(s.t, s.q, s.dq, s.tau)
+                                                         : estimator.update(s.t, s.q, s.dq, s.tau, s.sensor));
+        writer.write(estimator.result());
+      }
+    }
+    writer.close();
+  } catch (const Error& e) {
+    o.error = e.what();
+  }
+  o.estimates = read_file(out_dir / "estimates.csv");
+  return o;
+}
+
+Outcome pipelined(const RobotDescription& robot, const EstimatorOptions& options, const fs::path& log,
+                  const fs::path& out_dir) {
+  ReplayOptions ro;
+  ro.log = log;
+  ro.out_dir = out_dir;
+  ro.figures = false;
+  Outcome o;
+  try {
+    const ReplayResult r = replay_log(robot.model, robot.geometry, options, ro);
+    EXPECT_GT(r.rows, 0);
+  } catch (const Error& e) {
+    o.error = e.what();
+  }
+  o.estimates = read_file(out_dir / "estimates.csv");
+  return o;
+}
+
+long lines_of(const std::string& text) { return static_cast<long>(std::count(text.begin(), text.end(), '\n')); }
+
+EstimatorOptions ft_options() {
+  EstimatorOptions options;
+  options.sensor.type = SensorType::kForceTorque;
+  return options;
+}
+
+TEST_F(ReplayPipeline, WritesTheSameBytesAsThePlainLoopWhateverTheNumberOfBatches) {
+  // Fewer rows than a batch, exactly one turn of the ring, and a partial batch after it.
+  for (const long rows : {long{700}, 4 * kBatch, 5 * kBatch + 3}) {
+    const fs::path log = dir_ / ("log_" + std::to_string(rows) + ".csv");
+    write_log(log, rows, true);
+    const fs::path out = dir_ / ("same_" + std::to_string(rows));
+    const Outcome expected = plain_loop(*robot_, ft_options(), log, out / "plain");
+    const Outcome got = pipelined(*robot_, ft_options(), log, out / "pipelined");
+    ASSERT_EQ(expected.error, "") << rows;
+    EXPECT_EQ(got.error, "") << rows;
+    EXPECT_EQ(lines_of(got.estimates), rows + 1);
+    EXPECT_TRUE(got.estimates == expected.estimates) << rows << " rows: estimates differ";
+    // Several status texts went through the writer's cache.
+    EXPECT_NE(got.estimates.find(",free,"), std::string::npos);
+    EXPECT_NE(got.estimates.find("contact|"), std::string::npos);
+  }
+}
+
+TEST_F(ReplayPipeline, LogWithoutVelocitiesIsDifferentiatedAcrossBatchesAsInThePlainLoop) {
+  const fs::path log = dir_ / "no_dq.csv";
+  write_log(log, 3 * kBatch + 17, false);
+  EstimatorOptions options;  // no sensor: the other update()
+  const Outcome expected = plain_loop(*robot_, options, log, dir_ / "no_dq" / "plain");
+  const Outcome got = pipelined(*robot_, options, log, dir_ / "no_dq" / "pipelined");
+  ASSERT_EQ(expected.error, "");
+  EXPECT_EQ(got.error, "");
+  EXPECT_TRUE(got.estimates == expected.estimates) << "estimates differ";
+}
+
+TEST_F(ReplayPipeline, MalformedRowFailsWithTheSameTextAfterTheSameRowsAsThePlainLoop) {
+  const long rows = 5 * kBatch;
+  const fs::path good = dir_ / "good.csv";
+  write_log(good, rows, true);
+  struct Case {
+    long row;           // 0-based data row that is malformed
+    int cell;           // 0-based cell replaced
+    std::string value;
+    std::string expected;  // part of the message
+  };
+  const std::vector<Case> cases = {
+      {0, 2, "abc", ":2: column 3 'q2': expected a number, got 'abc'"},
+      {kBatch - 1, 2, "abc", ":1025: column 3 'q2': expected a number, got 'abc'"},
+      {kBatch, 5, "1.2.3", ":1026: column 6 'q5': expected a number, got '1.2.3'"},
+      {2 * kBatch + 500, 0, "0.001", ":2550: column 1 't': time must increase (0.001 after 2.54"},
+      {4 * kBatch + 1, 20, "", ":4099: column 21 'tau6': empty cell, expected a number"},
+      {rows - 1, 28, "link9", ":5121: column 29 'true_link': 'link9' is not a link of robot 'paper_arm'"},
+  };
+  for (const Case& c : cases) {
+    const std::string name = "bad_" + std::to_string(c.row);
+    const fs::path log = dir_ / (name + ".csv");
+    corrupt_row(good, log, c.row, row_with_cell(good, c.row, c.cell, c.value));
+    const Outcome expected = plain_loop(*robot_, ft_options(), log, dir_ / name / "plain");
+    const Outcome got = pipelined(*robot_, ft_options(), log, dir_ / name / "pipelined");
+    EXPECT_NE(expected.error.find(c.expected), std::string::npos) << expected.error;
+    EXPECT_EQ(got.error, expected.error);
+    // Every row before the malformed one was estimated and written, and nothing after it.
+    EXPECT_EQ(lines_of(got.estimates), c.row + 1) << c.row;
+    EXPECT_TRUE(got.estimates == expected.estimates) << c.row << ": estimates differ";
+  }
+}
+
+TEST_F(ReplayPipeline, MalformedSecondRowOfALogWithoutVelocitiesFailsBeforeAnyRowIsWritten) {
+  // The first row's q̇ is a forward difference: the second row is read before the first is
+  // returned, so its error comes first.
+  const fs::path good = dir_ / "no_dq_good.csv";
+  write_log(good, 50, false);
+  const fs::path log = dir_ / "no_dq_bad.csv";
+  corrupt_row(good, log, 1, row_with_cell(good, 1, 3, "x"));
+  const Outcome expected = plain_loop(*robot_, EstimatorOptions{}, log, dir_ / "no_dq_bad" / "plain");
+  const Outcome got = pipelined(*robot_, EstimatorOptions{}, log, dir_ / "no_dq_bad" / "pipelined");
+  EXPECT_NE(got.error.find(":3: column 4 'q3': expected a number, got 'x'"), std::string::npos) << got.error;
+  EXPECT_EQ(got.error, expected.error);
+  EXPECT_EQ(lines_of(got.estimates), 1);
+  EXPECT_TRUE(got.estimates == expected.estimates);
+}
+
+TEST_F(ReplayPipeline, AFailedWriteStopsTheReplayWithTheWritersError) {
+  // estimates.csv on a full disk: the writer thread fails at its first flush, while the reader
+  // still has rows; the error must come out, not a hang.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  const fs::path log = dir_ / "for_full_disk.csv";
+  write_log(log, 6 * kBatch, true);
+  const fs::path out = dir_ / "full_disk";
+  fs::create_directories(out);
+  fs::create_symlink("/dev/full", out / "estimates.csv");
+  ReplayOptions ro;
+  ro.log = log;
+  ro.out_dir = out;
+  ro.figures = false;
+  std::string error;
+  try {
+    (void)replay_log(robot_->model, robot_->geometry, ft_options(), ro);
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("estimates.csv: write failed"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace extwrench
