@@ -1,5 +1,6 @@
 #include "extwrench/io/replay.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -313,9 +314,32 @@ void write_script(const std::filesystem::path& path, const std::string& text) {
 
 // ---- figures ------------------------------------------------------------------------------
 
+// gnuplot draws on one core and the figures are independent: two at a time. A failure is
+// reported for the first failing script in order, as a sequential run would report it.
+void run_gnuplot_scripts(const std::vector<std::filesystem::path>& scripts) {
+  std::vector<std::exception_ptr> errors(scripts.size());
+  std::atomic<std::size_t> next{0};
+  auto run_some = [&] {
+    for (std::size_t k = next++; k < scripts.size(); k = next++) {
+      try {
+        run_gnuplot(scripts[k]);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    }
+  };
+  std::thread helper(run_some);
+  run_some();
+  helper.join();
+  for (const auto& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+}
+
 std::vector<std::filesystem::path> make_figures(const Model& model, const Decimator& dec,
                                                 const ReplayOptions& o, bool truth, const Vector3& p_WS) {
   std::vector<std::filesystem::path> pngs;
+  std::vector<std::filesystem::path> scripts;  // run together at the end
   const std::filesystem::path dir = o.out_dir;
   const std::filesystem::path data = dir / "plot_data.txt";
   dec.write(data);
@@ -333,7 +357,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     }
     s << "\n";
     write_script(dir / "joints.gp", s.str());
-    run_gnuplot(dir / "joints.gp");
+    scripts.push_back(dir / "joints.gp");
     pngs.push_back(dir / "joints.png");
   }
   const char* axis[] = {"x", "y", "z"};
@@ -357,7 +381,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     }
     s << "unset multiplot\n";
     write_script(dir / "force.gp", s.str());
-    run_gnuplot(dir / "force.gp");
+    scripts.push_back(dir / "force.gp");
     pngs.push_back(dir / "force.png");
   }
   {  // Figs. 7 / 9: p̂ of eq. (20) and the true contact point
@@ -374,7 +398,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     }
     s << "unset multiplot\n";
     write_script(dir / "line_point.gp", s.str());
-    run_gnuplot(dir / "line_point.gp");
+    scripts.push_back(dir / "line_point.gp");
     pngs.push_back(dir / "line_point.png");
   }
   {  // Fig. 10: condition numbers
@@ -389,7 +413,7 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     }
     s << "\n";
     write_script(dir / "condition.gp", s.str());
-    run_gnuplot(dir / "condition.gp");
+    scripts.push_back(dir / "condition.gp");
     pngs.push_back(dir / "condition.png");
   }
   {  // 3-D view at a few instants
@@ -463,9 +487,10 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     }
     s << "unset multiplot\n";
     write_script(dir / "robot3d.gp", s.str());
-    run_gnuplot(dir / "robot3d.gp");
+    scripts.push_back(dir / "robot3d.gp");
     pngs.push_back(dir / "robot3d.png");
   }
+  run_gnuplot_scripts(scripts);
   return pngs;
 }
 
