@@ -55,6 +55,14 @@ ParseResult parse_strict(std::string_view s, double& value) {
   return ParseResult::kOk;
 }
 
+// The common case of a cell, a finite number without a leading '+', in one call: what both
+// number() and number_or_nan() return as is (parse() handles everything else).
+bool plain_number(std::string_view s, double& value) {
+  if (s.empty() || s.front() == '+') return false;
+  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
+  return ec == std::errc() && ptr == s.data() + s.size() && std::isfinite(value);
+}
+
 }  // namespace
 
 std::optional<double> parse_number(std::string_view text) {
@@ -307,8 +315,21 @@ double CsvReader::parse(int column, bool allow_missing) const {
   return value;
 }
 
-double CsvReader::number(int column) const { return parse(column, false); }
-double CsvReader::number_or_nan(int column) const { return parse(column, true); }
+double CsvReader::number(int column) const {
+  double value = 0.0;
+  if (static_cast<std::size_t>(column) < cells_.size() && plain_number(cells_[static_cast<std::size_t>(column)], value)) {
+    return value;
+  }
+  return parse(column, false);  // the rest, with messages that name what is wrong
+}
+
+double CsvReader::number_or_nan(int column) const {
+  double value = 0.0;
+  if (static_cast<std::size_t>(column) < cells_.size() && plain_number(cells_[static_cast<std::size_t>(column)], value)) {
+    return value;
+  }
+  return parse(column, true);
+}
 
 // ------------------------------------------------------------------------------------------
 // CsvWriter
