@@ -1,6 +1,8 @@
 // Replaying a robot log through the contact estimator: the engine of `extwrench estimate`, and
 // of `extwrench simulate`, which replays the log it just wrote through the very same code.
-// Streaming: memory does not depend on the log's length (figures are decimated).
+// Streaming: memory does not depend on the log's length (figures are decimated). Three threads
+// share the work: one reads and parses the log, the calling thread estimates, one formats and
+// writes estimates.csv; they hand rows along in batches recycled through fixed rings.
 #pragma once
 
 #include <filesystem>
@@ -44,7 +46,8 @@ struct ReplayResult {
 /// estimator) on it, writes out_dir/estimates.csv, and with truth columns out_dir/metrics.json;
 /// figures (PNG, gnuplot) unless disabled. The first row resets the estimator (its output row is
 /// "free" with a zero residual). Throws extwrench::Error on malformed logs (file, line, column)
-/// and when the log lacks the columns the configuration's sensor needs.
+/// and when the log lacks the columns the configuration's sensor needs; a malformed row fails
+/// after every row before it was estimated and written, as in a row-by-row loop.
 ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator, const ReplayOptions& options);
 
