@@ -1,6 +1,8 @@
 #include "extwrench/io/replay.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -14,6 +16,7 @@
 #include <thread>
 
 #include <Eigen/SVD>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "extwrench/core/error.hpp"
@@ -32,6 +35,17 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // once and recycled (memory does not grow with the log); hand-offs are per batch, not per row.
 constexpr std::size_t kBatches = 4;       // per ring: enough slack for the stages' jitter
 constexpr std::size_t kBatchRows = 1024;  // rows per hand-off
+// The estimating thread is the critical path: when the threads outnumber the free cores, the
+// reader and the writer give way to it. Linux keeps a nice value per thread; theirs is raised
+// by kHelperNice over the process's (never lowered; a failure only costs speed).
+constexpr int kHelperNice = 5;
+
+void give_way_to_the_estimator() {
+  const auto tid = static_cast<id_t>(::gettid());
+  errno = 0;
+  const int nice = ::getpriority(PRIO_PROCESS, tid);
+  if (errno == 0) (void)::setpriority(PRIO_PROCESS, tid, std::min(nice + kHelperNice, 19));
+}
 
 /// A bounded ring of batches from one producer thread to one consumer thread, in order.
 template <class Item>
@@ -165,6 +179,7 @@ class Pipeline {
 
  private:
   void read_rows(LogReader& reader) {
+    give_way_to_the_estimator();
     for (;;) {
       auto* b = in_.acquire_free();
       if (b == nullptr) return;  // cancelled: the consumer has stopped
@@ -187,6 +202,7 @@ class Pipeline {
   }
 
   void write_rows(EstimatesWriter& writer) {
+    give_way_to_the_estimator();
     try {
       for (;;) {
         auto* b = out_.acquire_full();
