@@ -102,39 +102,104 @@ void momentum_terms_no_kinematics(const Model& model, Data& data,
   }
 }
 
-void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
-                    const Eigen::Ref<const VectorX>& dq) {
-  // As momentum_terms_no_kinematics, with each body's momentum taken about its CoM with the
-  // constant body-axes inertia I_c: no world inertia R I_c R^T is formed (see rnea).
-  detail::poses_and_subspaces(model, data, q);
+namespace {
+
+/// One pass over the bodies for momentum_terms (and, with `full`, momentum_and_bias_terms): the
+/// poses, each body's momentum about its CoM with the constant body-axes inertia I_c (no world
+/// inertia R I_c R^T is formed unless `full` asks for the world mass properties), and with
+/// `full` the bias wrench f_i = I_i a_i + v_i x* h_i at q_ddot = 0 (gravity trick). Along a
+/// chain the parent's pose and motion stay in registers.
+template <bool full>
+void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                   const Eigen::Ref<const VectorX>& dq) {
   const int nb = model.num_bodies();
   const Vector3& g = model.gravity;
+  data.X_WB[0] = Pose{};
+  data.S[0].setZero();
   data.v[0].setZero();
-  data.f[0].setZero();  // link 0 is at rest
+  data.f[0].setZero();  // link 0 is at rest: no momentum
   data.h[0].setZero();
-  data.composite_mass[0] = model.bodies[0].inertia.mass;
-  data.composite_first_moment[0] = model.bodies[0].inertia.mass * model.bodies[0].inertia.com;
+  {
+    const Inertia& inertia = model.bodies[0].inertia;
+    data.composite_mass[0] = inertia.mass;
+    data.composite_first_moment[0] = inertia.mass * inertia.com;
+    if constexpr (full) {
+      data.a[0].setZero();
+      data.a[0].head<3>() = -g;
+      // Link 0's weight, carried by the ground: f_0 = [m (-g); c x m (-g)].
+      const Vector3 F = -inertia.mass * g;
+      data.bias_f[0] << F, inertia.com.cross(F);
+    }
+  }
+  if constexpr (full) detail::world_mass_properties_of(model, data, 0);
+  Pose X_parent;
+  Vector3 v_O = Vector3::Zero();
+  Vector3 w = Vector3::Zero();
+  Vector3 a_O = -g;
+  Vector3 w_dot = Vector3::Zero();
   for (int i = 1; i < nb; ++i) {
-    data.v[i] = data.v[model.parents[i]] + data.S[i] * dq[i - 1];
+    const int p = model.parents[i];
+    if (p != i - 1) {
+      X_parent = data.X_WB[p];
+      v_O = data.v[p].head<3>();
+      w = data.v[p].tail<3>();
+      if constexpr (full) {
+        a_O = data.a[p].head<3>();
+        w_dot = data.a[p].tail<3>();
+      }
+    }
+    Matrix3 R;
+    Vector3 O;
+    Vector3 s_lin;
+    Vector3 s_ang;
+    detail::joint_kinematics(model, data, i, X_parent, q[i - 1], R, O, s_lin, s_ang);
+    const Vector3 vj_lin = s_lin * dq[i - 1];
+    const Vector3 vj_ang = s_ang * dq[i - 1];
+    if constexpr (full) {
+      // a_i = a_p + v_p x S q_dot  (q_ddot = 0)
+      a_O += w.cross(vj_lin) + v_O.cross(vj_ang);
+      w_dot += w.cross(vj_ang);
+    }
+    v_O += vj_lin;
+    w += vj_ang;
     const Inertia& inertia = model.bodies[i].inertia;
-    const Pose& X = data.X_WB[i];
-    const Vector3 c = X.act(inertia.com);
-    const auto w = detail::ang(data.v[i]);
+    const Vector3 c = R * inertia.com + O;
     // h_i about the world origin: [m v_c; I_c,W w + c x m v_c], v_c the velocity of the CoM.
-    const Vector3 L = inertia.mass * (detail::lin(data.v[i]) + w.cross(c));
-    const Vector3 w_B = X.rotation.transpose() * w;
-    const Vector3 Iw_B = inertia.inertia_com * w_B;
-    data.f[i].head<3>() = L;
-    data.f[i].tail<3>().noalias() = X.rotation * Iw_B;
-    data.f[i].tail<3>() += c.cross(L);
-    data.h[i] = data.f[i];  // f accumulates H_i = sum of h_k over sub(i) below
+    const Vector3 v_c = v_O + w.cross(c);
+    const Vector3 L = inertia.mass * v_c;
+    const Vector3 w_B = R.transpose() * w;
+    const Vector3 Iw = R * (inertia.inertia_com * w_B);  // I_c,W w
+    const Vector3 K = Iw + c.cross(L);
+    data.X_WB[i].rotation = R;
+    data.X_WB[i].translation = O;
+    data.S[i].head<3>() = s_lin;
+    data.S[i].tail<3>() = s_ang;
+    data.v[i].head<3>() = v_O;
+    data.v[i].tail<3>() = w;
+    data.h[i].head<3>() = L;
+    data.h[i].tail<3>() = K;
+    data.f[i].head<3>() = L;  // f accumulates H_i = sum of h_k over sub(i) below
+    data.f[i].tail<3>() = K;
     data.composite_mass[i] = inertia.mass;
     data.composite_first_moment[i] = inertia.mass * c;
+    if constexpr (full) {
+      data.a[i].head<3>() = a_O;
+      data.a[i].tail<3>() = w_dot;
+      // Newton-Euler about the CoM (see rnea): F = m c_ddot, N_c = I_c,W w_dot + w x I_c,W w.
+      const Vector3 F = inertia.mass * (a_O + w_dot.cross(c) + w.cross(v_c));
+      const Vector3 N = R * (inertia.inertia_com * (R.transpose() * w_dot)) + w.cross(Iw) + c.cross(F);
+      data.bias_f[i].head<3>() = F;
+      data.bias_f[i].tail<3>() = N;
+      detail::world_mass_properties_of(model, data, i);
+    }
+    X_parent.rotation = R;
+    X_parent.translation = O;
   }
   for (int i = nb - 1; i > 0; --i) {
     const int p = model.parents[i];
     const Vector6& s = data.S[i];
     data.momentum[i - 1] = s.dot(data.f[i]);  // p_i = S_i^T H_i
+    // (C^T q_dot)_i = -S_i^T (v_p x* H_i) (see momentum_terms_no_kinematics)
     data.coriolis_transpose_dq[i - 1] = -s.dot(detail::cross_force(data.v[p], data.f[i]));
     const double mc = data.composite_mass[i];
     const Vector3& hc = data.composite_first_moment[i];
@@ -142,7 +207,24 @@ void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const Vecto
     data.f[p] += data.f[i];
     data.composite_mass[p] += mc;
     data.composite_first_moment[p] += hc;
+    if constexpr (full) {
+      data.tau[i - 1] = s.dot(data.bias_f[i]);  // c_i = S_i^T f_i  (f_i: the subtree's)
+      data.bias_f[p] += data.bias_f[i];
+    }
   }
+  if constexpr (full) data.root_wrench_W = data.bias_f[0];
+}
+
+}  // namespace
+
+void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                    const Eigen::Ref<const VectorX>& dq) {
+  momentum_pass<false>(model, data, q, dq);
+}
+
+void momentum_and_bias_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                             const Eigen::Ref<const VectorX>& dq) {
+  momentum_pass<true>(model, data, q, dq);
 }
 
 bool forward_dynamics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,

@@ -37,8 +37,18 @@ Data::Data(const Model& model) {
   const int n = model.nq();
   placement_axis.assign(nb, {-1, -1, -1});
   placement_sign.assign(nb, Vector3::Zero());
+  axis_index.assign(nb, -1);
+  axis_sign.assign(nb, 0.0);
   for (std::size_t i = 1; i < nb && i < model.joints.size(); ++i) {
-    classify_rotation(model.joints[i].placement.rotation, placement_axis[i], placement_sign[i]);
+    const Joint& joint = model.joints[i];
+    classify_rotation(joint.placement.rotation, placement_axis[i], placement_sign[i]);
+    for (int k = 0; k < 3; ++k) {
+      const Vector3& a = joint.axis;
+      if (std::abs(a[k]) == 1.0 && a[(k + 1) % 3] == 0.0 && a[(k + 2) % 3] == 0.0) {
+        axis_index[i] = k;
+        axis_sign[i] = a[k];
+      }
+    }
   }
   X_WB.assign(nb, Pose{});
   S.assign(nb, Vector6::Zero());
@@ -49,6 +59,7 @@ Data::Data(const Model& model) {
   a.assign(nb, Vector6::Zero());
   f.assign(nb, Vector6::Zero());
   h.assign(nb, Vector6::Zero());
+  bias_f.assign(nb, Vector6::Zero());
   composite_mass.assign(nb, 0.0);
   composite_first_moment.assign(nb, Vector3::Zero());
   composite_inertia_O.assign(nb, Matrix3::Zero());

@@ -17,9 +17,35 @@ const VectorX& backward_pass(const Model& model, Data& data,
     data.f[w.body].head<3>() -= w.force_W;
     data.f[w.body].tail<3>() -= w.moment_W + w.point_W.cross(w.force_W);
   }
+  // The subtree wrench of the child just finished is carried in registers along a chain; at a
+  // branching of a tree it is added into the parent's entry of data.f instead.
+  Vector3 F_child = Vector3::Zero();
+  Vector3 N_child = Vector3::Zero();
   for (int i = nb - 1; i > 0; --i) {
-    data.tau[i - 1] = data.S[i].dot(data.f[i]);
-    data.f[model.parents[i]] += data.f[i];
+    const int p = model.parents[i];
+    const bool chain_child = i + 1 < nb && model.parents[i + 1] == i;
+    Vector3 F = data.f[i].head<3>();
+    Vector3 N = data.f[i].tail<3>();
+    if (chain_child) {
+      F += F_child;
+      N += N_child;
+    }
+    data.f[i].head<3>() = F;  // f_i: the wrench joint i transmits (the subtree's)
+    data.f[i].tail<3>() = N;
+    data.tau[i - 1] = data.S[i].head<3>().dot(F) + data.S[i].tail<3>().dot(N);
+    if (p == i - 1) {
+      F_child = F;
+      N_child = N;
+    } else {
+      data.f[p].head<3>() += F;
+      data.f[p].tail<3>() += N;
+      F_child.setZero();
+      N_child.setZero();
+    }
+  }
+  if (nb > 1 && model.parents[1] == 0) {
+    data.f[0].head<3>() += F_child;
+    data.f[0].tail<3>() += N_child;
   }
   data.root_wrench_W = data.f[0];
   return data.tau;
@@ -45,32 +71,61 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
     const Vector3 F = -inertia.mass * model.gravity;
     data.f[0] << F, inertia.com.cross(F);
   }
+  // The parent's motion [v_O; w], [a_O; w_dot] is carried in registers along a chain (body
+  // i - 1), reloaded from data only at a branching of a tree.
+  Vector3 v_O = Vector3::Zero();
+  Vector3 w = Vector3::Zero();
+  Vector3 a_O = -model.gravity;
+  Vector3 w_dot = Vector3::Zero();
+  Pose X_parent;  // likewise the parent's pose
   for (int i = 1; i < nb; ++i) {
     const int p = model.parents[i];
-    detail::joint_kinematics(model.joints[i], data.placement_axis[i], data.placement_sign[i],
-                             data.X_WB[p], q[i - 1], data.X_WB[i], data.S[i]);
-    const Vector6& s = data.S[i];
-    const Vector6 vj = s * dq[i - 1];
-    data.v[i] = data.v[p] + vj;
-    // a_i = a_p + S q_ddot + S_dot q_dot, with S_dot = v_p x S (S is fixed in the parent).
-    data.a[i] = data.a[p] + s * ddq[i - 1] + detail::cross_motion(data.v[p], vj);
+    if (p != i - 1) {
+      X_parent = data.X_WB[p];
+      v_O = data.v[p].head<3>();
+      w = data.v[p].tail<3>();
+      a_O = data.a[p].head<3>();
+      w_dot = data.a[p].tail<3>();
+    }
+    Matrix3 R;
+    Vector3 O;
+    Vector3 s_lin;
+    Vector3 s_ang;
+    detail::joint_kinematics(model, data, i, X_parent, q[i - 1], R, O, s_lin, s_ang);
+    // v_i = v_p + S q_dot; a_i = a_p + S q_ddot + v_p x S q_dot (S_dot = v_p x S: S is fixed in
+    // the parent), with v x m = [w x m_v + v_O x m_w; w x m_w].
+    const double qd = dq[i - 1];
+    const double qdd = ddq[i - 1];
+    const Vector3 vj_lin = s_lin * qd;
+    const Vector3 vj_ang = s_ang * qd;
+    a_O += s_lin * qdd + w.cross(vj_lin) + v_O.cross(vj_ang);
+    w_dot += s_ang * qdd + w.cross(vj_ang);
+    v_O += vj_lin;
+    w += vj_ang;
     // (7)-(8) about the CoM c: F = m c_ddot, N_c = I_c w_dot + w x I_c w (body axes, rotated
     // back), then moved to the world origin: f_i = [F; N_c + c x F] (= I_i a_i + v_i x* I_i v_i).
     const Inertia& inertia = model.bodies[i].inertia;
-    const Pose& X = data.X_WB[i];
-    const Vector3 c = X.act(inertia.com);
-    const auto w = detail::ang(data.v[i]);
-    const auto w_dot = detail::ang(data.a[i]);
+    const Vector3 c = R * inertia.com + O;
     // c_ddot = a_O + w_dot x c + w x (v_O + w x c): the spatial acceleration at the world origin
     // turned into the classical acceleration of the body point at c.
-    const Vector3 v_c = detail::lin(data.v[i]) + w.cross(c);
-    const Vector3 F = inertia.mass * (detail::lin(data.a[i]) + w_dot.cross(c) + w.cross(v_c));
-    const Vector3 w_B = X.rotation.transpose() * w;
-    const Vector3 w_dot_B = X.rotation.transpose() * w_dot;
+    const Vector3 v_c = v_O + w.cross(c);
+    const Vector3 F = inertia.mass * (a_O + w_dot.cross(c) + w.cross(v_c));
+    const Vector3 w_B = R.transpose() * w;
+    const Vector3 w_dot_B = R.transpose() * w_dot;
     const Vector3 N_B = inertia.inertia_com * w_dot_B + w_B.cross(inertia.inertia_com * w_B);
+    const Vector3 N = R * N_B + c.cross(F);
+    data.X_WB[i].rotation = R;
+    data.X_WB[i].translation = O;
+    data.S[i].head<3>() = s_lin;
+    data.S[i].tail<3>() = s_ang;
+    data.v[i].head<3>() = v_O;
+    data.v[i].tail<3>() = w;
+    data.a[i].head<3>() = a_O;
+    data.a[i].tail<3>() = w_dot;
     data.f[i].head<3>() = F;
-    data.f[i].tail<3>().noalias() = X.rotation * N_B;
-    data.f[i].tail<3>() += c.cross(F);
+    data.f[i].tail<3>() = N;
+    X_parent.rotation = R;
+    X_parent.translation = O;
   }
   return backward_pass(model, data, external);
 }
@@ -113,10 +168,13 @@ Vector6 sensor_reading_world(const Data& data, const Vector3& p_WS) {
 }
 
 Vector6 sensor_reading(const Data& data, const Pose& X_WS) {
-  const Vector6 w = sensor_reading_world(data, X_WS.translation);
+  // As sensor_reading_world, then rotated into the sensor frame: [R^T f_m; R^T n_m].
+  const Vector3 F0 = data.root_wrench_W.head<3>();
+  const Vector3 N0 = data.root_wrench_W.tail<3>();
+  const Vector3 n_m = X_WS.translation.cross(F0) - N0;
   Vector6 out;
-  out.head<3>().noalias() = X_WS.rotation.transpose() * w.head<3>();
-  out.tail<3>().noalias() = X_WS.rotation.transpose() * w.tail<3>();
+  out.head<3>().noalias() = -(X_WS.rotation.transpose() * F0);
+  out.tail<3>().noalias() = X_WS.rotation.transpose() * n_m;
   return out;
 }
 

@@ -60,10 +60,22 @@ inline Matrix6 cross_force_matrix(const Vector6& v) {
   return out;
 }
 
+/// sin and cos of one angle in one libm call where the C library has one (glibc's sincos; GCC
+/// does not always fuse separate std::sin and std::cos calls, and they are a large part of FK).
+inline void sin_cos(double angle, double& s, double& c) {
+#if defined(__GLIBC__)
+  ::sincos(angle, &s, &c);
+#else
+  s = std::sin(angle);
+  c = std::cos(angle);
+#endif
+}
+
 /// Rotation by `angle` about the unit `axis` (Rodrigues).
 inline Matrix3 axis_rotation(const Vector3& axis, double angle) {
-  const double s = std::sin(angle);
-  const double c = std::cos(angle);
+  double s = 0.0;
+  double c = 0.0;
+  sin_cos(angle, s, c);
   const double t = 1.0 - c;
   const double x = axis.x(), y = axis.y(), z = axis.z();
   Matrix3 r;
@@ -73,62 +85,94 @@ inline Matrix3 axis_rotation(const Vector3& axis, double angle) {
   return r;
 }
 
-/// R * Rot(axis, angle) for a body whose joint frame has world rotation R (s = sin, c = cos).
-/// A coordinate axis (+-x, +-y, +-z, the URDF/DH norm) only mixes two columns of R (12 flops
-/// instead of Rodrigues plus a 3x3 product); any other axis takes the general path.
-inline void rotate_about_axis(const Matrix3& R, const Vector3& axis, double s, double c,
-                              Matrix3& out) {
-  for (int k = 0; k < 3; ++k) {
-    const int i = (k + 1) % 3;
-    const int j = (k + 2) % 3;
-    if (axis[i] == 0.0 && axis[j] == 0.0 && (axis[k] == 1.0 || axis[k] == -1.0)) {
-      // Rot(e_k, q): column i -> c e_i + s e_j, column j -> -s e_i + c e_j (s flips with -e_k).
-      const double sk = axis[k] * s;
-      out.col(k) = R.col(k);
-      out.col(i) = c * R.col(i) + sk * R.col(j);
-      out.col(j) = c * R.col(j) - sk * R.col(i);
-      return;
-    }
-  }
-  const double t = 1.0 - c;
-  const double x = axis.x(), y = axis.y(), z = axis.z();
-  Matrix3 r;
-  r << t * x * x + c, t * x * y - s * z, t * x * z + s * y,  //
-      t * x * y + s * z, t * y * y + c, t * y * z - s * x,   //
-      t * x * z - s * y, t * y * z + s * x, t * z * z + c;
-  out.noalias() = R * r;
-}
-
-/// Pose X_WB of body i and its joint's motion subspace S_i (world, about the world origin),
-/// from the parent's pose X_WP and q_i (placement_*: Data's classification of the placement).
-inline void joint_kinematics(const Joint& joint, const std::array<int, 3>& placement_axis,
-                             const Vector3& placement_sign, const Pose& X_WP, double qi, Pose& X_WB,
-                             Vector6& S) {
+/// Pose (R, p) of body i and its joint's motion subspace S_i = [s_lin; s_ang] (world, about the
+/// world origin), from the parent's pose X_WP and q_i, into local variables: callers keep them
+/// in registers and store them once (reloading vectors just written piecewise stalls the CPU's
+/// store forwarding). Uses Data's classification of the joint (right-angle placement,
+/// coordinate axis: the DH/URDF norm) to replace 3x3 products by column shuffles.
+[[gnu::always_inline]] inline void joint_kinematics(const Model& model, const Data& data, int i,
+                                                    const Pose& X_WP, double qi, Matrix3& R,
+                                                    Vector3& p, Vector3& s_lin, Vector3& s_ang) {
+  const Joint& joint = model.joints[i];
+  const auto& perm = data.placement_axis[i];
   Matrix3 R_WJ;  // joint frame at q = 0
-  if (placement_axis[0] >= 0) {
-    for (int k = 0; k < 3; ++k) R_WJ.col(k) = placement_sign[k] * X_WP.rotation.col(placement_axis[k]);
+  if (perm[0] >= 0) {
+    const Vector3& sign = data.placement_sign[i];
+    for (int k = 0; k < 3; ++k) R_WJ.col(k) = sign[k] * X_WP.rotation.col(perm[k]);
   } else {
     R_WJ.noalias() = X_WP.rotation * joint.placement.rotation;
   }
-  X_WB.translation.noalias() = X_WP.rotation * joint.placement.translation;
-  X_WB.translation += X_WP.translation;
-  // The URDF/DH norm is a coordinate axis: then axis_W is a column of R_WJ, no product.
-  const Vector3& a = joint.axis;
-  Vector3 axis_W;
-  if (a.x() == 0.0 && a.y() == 0.0 && a.z() == 1.0) {
-    axis_W = R_WJ.col(2);
+  p.noalias() = X_WP.rotation * joint.placement.translation;
+  p += X_WP.translation;
+  const int k = data.axis_index[i];
+  const bool revolute = joint.type == JointType::kRevolute;
+  if (k >= 0) {
+    const double sign = data.axis_sign[i];
+    s_ang = sign * R_WJ.col(k);
+    if (revolute) {
+      // Rot(±e_k, q) only mixes the two other columns: i -> c e_i + s e_j, j -> -s e_i + c e_j.
+      double s = 0.0;
+      double c = 0.0;
+      sin_cos(qi, s, c);
+      s *= sign;
+      constexpr int kNext[3] = {1, 2, 0};
+      const int i1 = kNext[k];
+      const int j1 = kNext[i1];
+      R.col(k) = R_WJ.col(k);
+      R.col(i1) = c * R_WJ.col(i1) + s * R_WJ.col(j1);
+      R.col(j1) = c * R_WJ.col(j1) - s * R_WJ.col(i1);
+    }
   } else {
-    axis_W.noalias() = R_WJ * a;
+    s_ang.noalias() = R_WJ * joint.axis;
+    if (revolute) R.noalias() = R_WJ * axis_rotation(joint.axis, qi);
   }
-  if (joint.type == JointType::kRevolute) {
-    rotate_about_axis(R_WJ, joint.axis, std::sin(qi), std::cos(qi), X_WB.rotation);
-    // Revolute about axis z through O_i: velocity of the body point at the world origin
-    // is O_i x z q_dot.
-    S << X_WB.translation.cross(axis_W), axis_W;
+  if (revolute) {
+    // Revolute about the axis through O_i: the body point at the world origin moves with
+    // O_i x axis q_dot.
+    s_lin = p.cross(s_ang);
   } else {
-    X_WB.rotation = R_WJ;
-    X_WB.translation += axis_W * qi;
-    S << axis_W, Vector3::Zero();
+    R = R_WJ;
+    p += s_ang * qi;
+    s_lin = s_ang;  // prismatic: S = [axis; 0]
+    s_ang.setZero();
+  }
+}
+
+/// joint_kinematics stored into data.X_WB[i] and data.S[i].
+[[gnu::always_inline]] inline void joint_kinematics(const Model& model, Data& data, int i, double qi) {
+  Matrix3 R;
+  Vector3 p;
+  Vector3 s_lin;
+  Vector3 s_ang;
+  joint_kinematics(model, data, i, data.X_WB[model.parents[i]], qi, R, p, s_lin, s_ang);
+  data.X_WB[i].rotation = R;
+  data.X_WB[i].translation = p;
+  data.S[i].head<3>() = s_lin;
+  data.S[i].tail<3>() = s_ang;
+}
+
+/// Body i's mass properties about the world origin from its pose in data: m, h = m c_W and
+/// I_O = R I_c R^T + m (|c|^2 1 - c c^T).
+inline void world_mass_properties_of(const Model& model, Data& data, int i) {
+  const Inertia& inertia = model.bodies[i].inertia;
+  const Pose& X = data.X_WB[i];
+  const Vector3 c_W = X.act(inertia.com);
+  const double m = inertia.mass;
+  data.mass[i] = m;
+  const Vector3 h = m * c_W;
+  data.first_moment_W[i] = h;
+  // Symmetric: A = R I_c once, then only the lower triangle of A R^T + m (|c|^2 1 - c c^T).
+  Matrix3 A;
+  A.noalias() = X.rotation * inertia.inertia_com;
+  const double mc2 = h.dot(c_W);
+  Matrix3& I_O = data.inertia_O_W[i];
+  for (int r = 0; r < 3; ++r) {
+    for (int col = 0; col <= r; ++col) {
+      const double e = A.row(r).dot(X.rotation.row(col)) - h[r] * c_W[col];
+      I_O(r, col) = e;
+      I_O(col, r) = e;
+    }
+    I_O(r, r) += mc2;
   }
 }
 
@@ -139,8 +183,7 @@ inline void poses_and_subspaces(const Model& model, Data& data, const Eigen::Ref
   data.X_WB[0] = Pose{};
   data.S[0].setZero();
   for (int i = 1; i < nb; ++i) {
-    joint_kinematics(model.joints[i], data.placement_axis[i], data.placement_sign[i],
-                     data.X_WB[model.parents[i]], q[i - 1], data.X_WB[i], data.S[i]);
+    joint_kinematics(model, data, i, q[i - 1]);
   }
 }
 

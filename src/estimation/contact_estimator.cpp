@@ -7,6 +7,7 @@
 #include <string>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/crba.hpp"
@@ -30,162 +31,101 @@ struct DlsInfo {
   double condition = kNaN;
 };
 
-/// A symmetric positive semi-definite R×R matrix A (here J Jᵀ) reduced to tridiagonal form
-/// T = Qᵀ A Q by R − 2 Householder reflections (lower triangle only), kept so that both the
-/// extreme eigenvalues and the solve with A + μ² I use T: one reduction, no Cholesky of A.
-template <int R>
-struct Tridiagonal {
-  double diag[R];     ///< T_ii
-  double sub[R];      ///< T_i,i−1 (sub[0] unused)
-  double v[R][R];     ///< Householder vector k on rows k+1..R−1
-  double beta[R];     ///< H_k = I − β_k v_k v_kᵀ (β_k = 0: identity)
-
-  explicit Tridiagonal(Eigen::Matrix<double, R, R> A) noexcept {
-    for (int k = 0; k + 2 < R; ++k) {
-      double tail2 = 0.0;
-      for (int i = k + 2; i < R; ++i) tail2 += A(i, k) * A(i, k);
-      beta[k] = 0.0;
-      if (tail2 == 0.0) continue;  // already tridiagonal in this column
-      const double x0 = A(k + 1, k);
-      const double alpha = x0 >= 0.0 ? -std::sqrt(x0 * x0 + tail2) : std::sqrt(x0 * x0 + tail2);
-      double* vk = v[k];
-      for (int i = k + 1; i < R; ++i) vk[i] = A(i, k);
-      vk[k + 1] -= alpha;
-      const double b = 2.0 / (tail2 + vk[k + 1] * vk[k + 1]);
-      beta[k] = b;
-      // H A H = A − v wᵀ − w vᵀ on the trailing block, w = p − (β vᵀp / 2) v, p = β A v.
-      double w[R];
-      for (int i = k + 1; i < R; ++i) {
-        double sum = 0.0;
-        for (int j = k + 1; j < R; ++j) sum += (j <= i ? A(i, j) : A(j, i)) * vk[j];
-        w[i] = b * sum;
-      }
-      double vp = 0.0;
-      for (int i = k + 1; i < R; ++i) vp += vk[i] * w[i];
-      const double half = 0.5 * b * vp;
-      for (int i = k + 1; i < R; ++i) w[i] -= half * vk[i];
-      for (int j = k + 1; j < R; ++j) {
-        for (int i = j; i < R; ++i) A(i, j) -= vk[i] * w[j] + w[i] * vk[j];
-      }
-      A(k + 1, k) = alpha;
-    }
-    for (int i = 0; i < R; ++i) {
-      diag[i] = A(i, i);
-      sub[i] = i > 0 ? A(i, i - 1) : 0.0;
+/// A = L D Lᵀ in place (unit lower L below the diagonal, 1/D on it; the upper triangle is not
+/// read): no square roots, and the solves multiply by the stored inverse pivots, which keeps
+/// divisions off their dependency chains. False when A is not numerically positive definite.
+/// For the fixed-size J Jᵀ and for B(q) up to kMaxPivots joints: no allocation.
+constexpr int kMaxPivots = 12;
+template <typename Matrix>
+bool ldlt_in_place(Matrix& A) noexcept {
+  const int n = static_cast<int>(A.rows());
+  double d[kMaxPivots];
+  for (int j = 0; j < n; ++j) {
+    double dj = A(j, j);
+    for (int k = 0; k < j; ++k) dj -= A(j, k) * A(j, k) * d[k];
+    if (!(dj > 0.0)) return false;
+    d[j] = dj;
+    const double inv = 1.0 / dj;
+    A(j, j) = inv;
+    for (int i = j + 1; i < n; ++i) {
+      double sum = A(i, j);
+      for (int k = 0; k < j; ++k) sum -= A(i, k) * A(j, k) * d[k];
+      A(i, j) = sum * inv;
     }
   }
-
-  /// x ← (A + shift I)⁻¹ x = Q (T + shift I)⁻¹ Qᵀ x; false when T + shift I is not (numerically)
-  /// positive definite. T + shift I = L D Lᵀ with a unit bidiagonal L: stable without pivoting
-  /// for a positive definite T.
-  bool solve(double shift, double* x) const noexcept {
-    for (int k = 0; k + 2 < R; ++k) reflect(k, x);  // Qᵀ x = H_{R−3} … H_0 x
-    double d[R];
-    double l[R];
-    d[0] = diag[0] + shift;
-    if (!(d[0] > 0.0)) return false;
-    for (int i = 1; i < R; ++i) {
-      l[i] = sub[i] / d[i - 1];
-      d[i] = diag[i] + shift - l[i] * sub[i];
-      if (!(d[i] > 0.0)) return false;
-    }
-    for (int i = 1; i < R; ++i) x[i] -= l[i] * x[i - 1];
-    x[R - 1] /= d[R - 1];
-    for (int i = R - 2; i >= 0; --i) x[i] = x[i] / d[i] - l[i + 1] * x[i + 1];
-    for (int k = R - 3; k >= 0; --k) reflect(k, x);  // Q y = H_0 … H_{R−3} y
-    return true;
-  }
-
- private:
-  void reflect(int k, double* x) const noexcept {
-    if (beta[k] == 0.0) return;
-    double dot = 0.0;
-    for (int i = k + 1; i < R; ++i) dot += v[k][i] * x[i];
-    dot *= beta[k];
-    for (int i = k + 1; i < R; ++i) x[i] -= dot * v[k][i];
-  }
-};
-
-/// The extreme eigenvalues (λ_min, λ_max) of the positive semi-definite matrix reduced to T, by
-/// Laguerre's iteration on det(T − x I). For a polynomial with only real roots Laguerre
-/// converges monotonically (cubically near the root) to the root next to the start, so starting
-/// below / above the spectrum yields λ_min / λ_max: from 0 (PSD) and from min(trace, Gershgorin
-/// bound), both close to their ends when J is ill-conditioned, the case that matters. The
-/// absolute error is O(ε‖A‖), as for a full symmetric eigensolver, at a fraction of its cost.
-template <int R>
-void extreme_eigenvalues(const Tridiagonal<R>& T, double& lambda_min, double& lambda_max) noexcept {
-  double b2[R];  // T_i,i−1²
-  double trace = 0.0;
-  double gershgorin = -kInf;
-  for (int i = 0; i < R; ++i) {
-    b2[i] = T.sub[i] * T.sub[i];
-    trace += T.diag[i];
-    double radius = 0.0;
-    if (i > 0) radius += std::abs(T.sub[i]);
-    if (i + 1 < R) radius += std::abs(T.sub[i + 1]);
-    gershgorin = std::max(gershgorin, T.diag[i] + radius);
-  }
-  const double hi = std::min(trace, gershgorin);
-  const double scale = std::abs(hi);
-  double x[2] = {0.0, hi};
-  const double direction[2] = {1.0, -1.0};  // from below (λ_min), from above (λ_max)
-  bool done[2] = {false, R == 1};
-  for (int it = 0; it < 100 && !(done[0] && done[1]); ++it) {
-    // Both ends evaluated unconditionally: two independent dependency chains that overlap.
-    double step[2];
-    bool stop[2];
-    for (int e = 0; e < 2; ++e) {
-      // det(T − xI) and its first two x-derivatives by the three-term recurrence.
-      double p0 = 1.0, d0 = 0.0, s0 = 0.0;                // k − 2
-      double p1 = T.diag[0] - x[e], d1 = -1.0, s1 = 0.0;  // k − 1
-      for (int k = 1; k < R; ++k) {
-        const double c = T.diag[k] - x[e];
-        const double p = c * p1 - b2[k] * p0;
-        const double d = c * d1 - p1 - b2[k] * d0;
-        const double s = c * s1 - 2.0 * d1 - b2[k] * s0;
-        p0 = p1; d0 = d1; s0 = s1;
-        p1 = p; d1 = d; s1 = s;
-      }
-      const double inv_p = 1.0 / p1;
-      const double G = d1 * inv_p;          // Σ 1/(x − λ_i)
-      const double H = G * G - s1 * inv_p;  // Σ 1/(x − λ_i)²
-      const double disc = std::max((R - 1) * (R * H - G * G), 0.0);
-      // Laguerre's step toward the spectrum (the larger-magnitude denominator).
-      const double den = std::abs(G) + std::sqrt(disc);
-      step[e] = R / den;
-      // x is an eigenvalue (e.g. 0 for a rank-deficient J), or round-off took over.
-      stop[e] = p1 == 0.0 || !std::isfinite(p1) || !(den > 0.0);
-    }
-    for (int e = 0; e < 2; ++e) {
-      if (done[e]) continue;
-      if (stop[e]) {
-        done[e] = true;
-        continue;
-      }
-      x[e] += direction[e] * step[e];
-      // Converged (cubically: the remaining error is far below the step) or at round-off level.
-      done[e] = !(step[e] > 1e-14 * std::abs(x[e]) && step[e] > 1e-15 * scale);
-    }
-  }
-  lambda_min = x[0];
-  lambda_max = R > 1 ? x[1] : x[0];
+  return true;
 }
+
+/// x ← A⁻¹ x with the factor of ldlt_in_place.
+template <typename Matrix, typename Vector>
+void ldlt_solve(const Matrix& LD, Vector& x) noexcept {
+  const int n = static_cast<int>(LD.rows());
+  for (int i = 1; i < n; ++i) {
+    for (int k = 0; k < i; ++k) x[i] -= LD(i, k) * x[k];
+  }
+  for (int i = 0; i < n; ++i) x[i] *= LD(i, i);
+  for (int i = n - 2; i >= 0; --i) {
+    for (int k = i + 1; k < n; ++k) x[i] -= LD(k, i) * x[k];
+  }
+}
+
+// Power / inverse iteration on J Jᵀ from the last sample's extreme eigenvectors: accepted once
+// the relative residual ‖A v − ρ v‖/ρ is below kSpectrumTolerance for both ends, which bounds
+// the eigenvalue error by ~tol² ρ²/gap (~1e-6 relative or better); else the exact path.
+constexpr double kSpectrumTolerance = 1e-3;
+constexpr int kSpectrumIterations = 4;
 
 /// Solves Jᵀ x = b in the damped least-squares sense, J: R×n of which only the first `cols`
 /// columns (the joints up to the contact link) can be non-zero. x = (J Jᵀ + μ² I)⁻¹ J b with
-/// the damping law of the header: σ_min, σ_max from the extreme eigenvalues of the R×R matrix
-/// J Jᵀ, the solve through the same tridiagonal form (fixed size: no allocation). The normal
-/// equations square κ: with κ ≤ 1e3 the relative error stays ~1e-10.
+/// the damping law of the header, by an LDLᵀ factorisation (fixed size: no allocation). σ_min and σ_max
+/// come from the extreme eigenvalues of A = J Jᵀ: J moves little between samples, so a few
+/// power (λ_max) and inverse (λ_min, with the Cholesky factor) iterations from the previous
+/// sample's eigenvectors (`guess`, `guess_size` = R when valid) usually suffice; otherwise (first
+/// sample, a change of link, fast motion near a singularity) a full symmetric eigensolver gives
+/// them exactly and seeds the next sample. The normal equations square κ: with κ ≤ 1e3 the
+/// relative error stays ~1e-10.
 template <int R, typename Derived>
 DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, int cols, const VectorX& b,
-                     const SolverOptions& opt, Eigen::Matrix<double, R, 1>& x) noexcept {
-  Eigen::Matrix<double, R, R> A;
+                     const SolverOptions& opt, Eigen::Matrix<double, R, 1>& x, Vector6& guess_min,
+                     Vector6& guess_max, int& guess_size) noexcept {
+  using MatR = Eigen::Matrix<double, R, R>;
+  using VecR = Eigen::Matrix<double, R, 1>;
+  MatR A;
   A.noalias() = J.leftCols(cols) * J.leftCols(cols).transpose();
   x.noalias() = J.leftCols(cols) * b.head(cols);
-  const Tridiagonal<R> T(A);
+  MatR L = A;
+  const bool factored = ldlt_in_place(L);
   double l_min = 0.0;
   double l_max = 0.0;
-  extreme_eigenvalues<R>(T, l_min, l_max);  // σ_min², σ_max²
+  bool estimated = false;
+  if (factored && guess_size == R) {
+    VecR v_max = guess_max.head<R>();
+    VecR v_min = guess_min.head<R>();
+    for (int it = 0; it < kSpectrumIterations && !estimated; ++it) {
+      const VecR u = A * v_max;  // power step: λ_max ≈ ρ = vᵀ A v
+      const double rho = v_max.dot(u);
+      const double res_max = (u - rho * v_max).norm();
+      v_max = u / u.norm();
+      VecR y = v_min;  // inverse step: 1/λ_min ≈ μ = vᵀ A⁻¹ v
+      ldlt_solve(L, y);
+      const double mu = v_min.dot(y);
+      const double res_min = (y - mu * v_min).norm();
+      v_min = y / y.norm();
+      l_max = rho;
+      l_min = 1.0 / mu;
+      estimated = res_max <= kSpectrumTolerance * rho && res_min <= kSpectrumTolerance * mu;
+    }
+    guess_max.head<R>() = v_max;
+    guess_min.head<R>() = v_min;
+  }
+  if (!estimated) {
+    const Eigen::SelfAdjointEigenSolver<MatR> eig(A);
+    l_min = eig.eigenvalues()[0];
+    l_max = eig.eigenvalues()[R - 1];
+    guess_min.head<R>() = eig.eigenvectors().col(0);
+    guess_max.head<R>() = eig.eigenvectors().col(R - 1);
+    guess_size = R;
+  }
   const double s_max = std::sqrt(std::max(l_max, 0.0));
   const double s_min = std::sqrt(std::max(l_min, 0.0));
   DlsInfo info;
@@ -194,8 +134,19 @@ DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, int cols, const Vector
   const double eps = s_max / opt.max_condition;  // ε = σ_max / κ_max
   const double mu2 = s_min < eps ? eps * eps - s_min * s_min : 0.0;
   info.damped = mu2 > 0.0;
-  // rank_ok ⇒ σ_min > 0 ⇒ J Jᵀ + μ² I is positive definite (round-off checked by the solve).
-  if (!info.rank_ok || !T.solve(mu2, x.data())) {
+  bool solved = false;
+  if (info.rank_ok) {
+    // rank_ok ⇒ σ_min > 0 ⇒ J Jᵀ + μ² I is positive definite (round-off checked).
+    if (mu2 == 0.0 && factored) {
+      solved = true;
+    } else {
+      L = A;
+      L.diagonal().array() += mu2;
+      solved = ldlt_in_place(L);
+    }
+    if (solved) ldlt_solve(L, x);
+  }
+  if (!solved) {
     info.rank_ok = false;
     x.setConstant(kNaN);  // unused by the callers: the wrench is unobservable
   }
@@ -292,6 +243,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   detector_.reset();
   disagreement_on_ = false;
   have_disagreement_edge_ = false;
+  spectrum_size_ = 0;  // a reset run matches a fresh estimator's bit for bit
   if (options_.sensor.tare_samples > 0) {
     bias_S_.setZero();
     request_tare(options_.sensor.tare_samples);
@@ -361,16 +313,21 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
     return s;
   }
   const double dt = t - t_;
-  observer_.advance(t, q, dq, tau);  // validated above
-  Data& data = observer_.workspace();
-  const Model& model = observer_.model();
   const bool need_ddq = options_.sensor.type != SensorType::kNone ||
                         options_.acceleration == AccelerationRoute::kDifferentiation;
+  const bool differentiation = options_.acceleration == AccelerationRoute::kDifferentiation;
+  // The observer's pass computes the poses and the momentum terms; route (b) also needs the
+  // world-frame mass properties (CRBA) and the bias c(q, q̇) with its ground wrench, which the
+  // same pass can give; route (a) needs the mass properties for its RNEA; case E neither.
+  using Extras = MomentumObserver::Extras;
+  const Extras extras = !need_ddq         ? Extras::kNone
+                        : differentiation ? Extras::kWorldInertias
+                                          : Extras::kWorldInertiasAndBias;
+  observer_.advance(t, q, dq, tau, extras);  // validated above
+  Data& data = observer_.workspace();
+  const Model& model = observer_.model();
   out_.status = Status::success();
   tau_eff_ = tau - observer_.friction_torque();  // τ − τ_f
-  // The observer's pass computed the poses; the CRBA and RNEA below also need the world-frame
-  // mass properties (case E, no sensor, does not).
-  if (need_ddq) world_mass_properties(model, data);
   if (options_.acceleration == AccelerationRoute::kDifferentiation) {
     // (a) q̈̂: backward difference of q̇ through a first-order low-pass (cutoff f_c), exact
     // discretization for the actual Δt.
@@ -381,17 +338,15 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
     }
     ddq_ = ddq_filtered_;
   } else if (need_ddq) {
-    // (b) q̈̂ = B⁻¹ (τ − τ_f + r − c(q, q̇)): forward dynamics with τ + r. The kinematics of q
-    // are already in `data` (observer pass).
+    // (b) q̈̂ = B⁻¹ (τ − τ_f + r − c(q, q̇)): forward dynamics with τ + r. The kinematics of q,
+    // c = C q̇ + g (data.tau) and its ground wrench f_0(0) are already in `data` (observer pass).
     crba_no_kinematics(model, data);
-    data.tmp_n.setZero();
-    rnea_no_kinematics(model, data, dq, data.tmp_n);  // c = C q̇ + g into data.tau
     ddq_ = tau_eff_ + observer_.residual() - data.tau;
     bool factored = false;
     if (n_ <= kInlineJoints) {
-      mass_llt_.compute(data.M);
-      factored = mass_llt_.info() == Eigen::Success;
-      if (factored) mass_llt_.solveInPlace(ddq_);
+      mass_ldlt_ = data.M;  // fixed capacity: no allocation
+      factored = ldlt_in_place(mass_ldlt_);
+      if (factored) ldlt_solve(mass_ldlt_, ddq_);
     } else {
       data.mass_llt.compute(data.M);
       factored = data.mass_llt.info() == Eigen::Success;
@@ -563,7 +518,8 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
       b_ = tau_ext_;
       b_.noalias() -= J_.topRows<3>().transpose() * F;
       Vector3 x;
-      const DlsInfo info = damped_solve<3>(J_.bottomRows<3>(), link, b_, options_.solver, x);
+      const DlsInfo info = damped_solve<3>(J_.bottomRows<3>(), link, b_, options_.solver, x, spectrum_min_,
+                                           spectrum_max_, spectrum_size_);
       out_.condition_number = info.condition;
       if (info.rank_ok) {
         M_bar = x;
@@ -573,7 +529,8 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
     } else {
       // E (27): W̄ = (J_lᵀ)# τ̂_1:l, rank J_l = 6 required.
       Vector6 x;
-      const DlsInfo info = damped_solve<6>(J_, link, tau_ext_, options_.solver, x);
+      const DlsInfo info = damped_solve<6>(J_, link, tau_ext_, options_.solver, x, spectrum_min_,
+                                           spectrum_max_, spectrum_size_);
       out_.condition_number = info.condition;
       if (info.rank_ok) {
         F = x.head<3>();

@@ -5,6 +5,7 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/crba.hpp"
+#include "extwrench/dynamics/kinematics.hpp"
 
 namespace extwrench {
 namespace {
@@ -105,9 +106,20 @@ Status MomentumObserver::set_payload(int body, const Inertia& payload) noexcept 
 void MomentumObserver::clear_payload() noexcept { apply_payload(-1, nullptr); }
 
 void MomentumObserver::compute_terms(const Eigen::Ref<const VectorX>& q,
-                                     const Eigen::Ref<const VectorX>& dq) noexcept {
+                                     const Eigen::Ref<const VectorX>& dq, Extras extras) noexcept {
   // m = B q̇, Cᵀq̇ and g in one O(n) pass (SPEC §2).
-  momentum_terms(model_, data_, q, dq);
+  switch (extras) {
+    case Extras::kNone:
+      momentum_terms(model_, data_, q, dq);
+      break;
+    case Extras::kWorldInertias:  // the workspace() contract for update() and reset()
+      momentum_terms(model_, data_, q, dq);
+      world_mass_properties(model_, data_);
+      break;
+    case Extras::kWorldInertiasAndBias:
+      momentum_and_bias_terms(model_, data_, q, dq);
+      break;
+  }
   extwrench::friction_torque(friction_, dq, tau_f_);
   // γ = Cᵀq̇ − g − τ_f: the state-dependent part of the integrand of (4).
   gamma_ = data_.coriolis_transpose_dq - data_.gravity_torque - tau_f_;
@@ -163,9 +175,9 @@ Status MomentumObserver::update(double t, const Eigen::Ref<const VectorX>& q,
 
 void MomentumObserver::advance(double t, const Eigen::Ref<const VectorX>& q,
                                const Eigen::Ref<const VectorX>& dq,
-                               const Eigen::Ref<const VectorX>& tau) noexcept {
+                               const Eigen::Ref<const VectorX>& tau, Extras extras) noexcept {
   const double dt = t - t_;
-  compute_terms(q, dq);
+  compute_terms(q, dq, extras);
   if (dt != alpha_dt_) {
     alpha_ = (-gains_ * dt).array().exp();  // e^{−K Δt}, recomputed only when Δt changes
     alpha_dt_ = dt;

@@ -126,6 +126,7 @@ TEST_P(DynamicsAllocations, MomentumTermsAllocateNothing) {
   Data data(model_);
   EXPECT_EQ(allocations_in([&] { momentum_terms(model_, data, q_, dq_); }), 0u);
   EXPECT_EQ(allocations_in([&] { momentum_terms_no_kinematics(model_, data, dq_); }), 0u);
+  EXPECT_EQ(allocations_in([&] { momentum_and_bias_terms(model_, data, q_, dq_); }), 0u);
   EXPECT_TRUE(data.momentum.allFinite() && data.coriolis_transpose_dq.allFinite());
 }
 

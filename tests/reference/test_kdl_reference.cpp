@@ -358,6 +358,11 @@ TEST_P(KdlReference, MassMatrixAndMomentumMatchKdl) {
     const double ep = rel_err(ref_.P * data.momentum, p_ref);
     worst_p.update(ep);
     EXPECT_LE(ep, kTol) << "state " << k;
+    // The fused pass leaves the world mass properties crba_no_kinematics needs.
+    momentum_and_bias_terms(model(), data, x.q, x.dq);
+    EXPECT_LE(rel_err(ref_.P * data.momentum, p_ref), kTol) << "state " << k;
+    const MatrixX m_fused = crba_no_kinematics(model(), data);
+    EXPECT_LE(rel_err(ref_.P * m_fused * ref_.P.transpose(), m_ref.data), kTol) << "state " << k;
   }
 }
 
@@ -378,6 +383,15 @@ TEST_P(KdlReference, CoriolisTimesVelocityMatchesKdl) {
                               rel_err(ref_.P * (bias - g), c_ref.data));
     worst.update(e);
     EXPECT_LE(e, kTol) << "state " << k;
+    // The fused momentum + bias pass: c(q, dq) - g(q) against KDL's C dq, and its ground
+    // wrench against the one of rnea at q_ddot = 0 (that one is checked against KDL above).
+    const Vector6 root_ref = [&] {
+      rnea(model(), data, x.q, x.dq, VectorX::Zero(x.q.size()));
+      return data.root_wrench_W;
+    }();
+    momentum_and_bias_terms(model(), data, x.q, x.dq);
+    EXPECT_LE(rel_err(ref_.P * (data.tau - data.gravity_torque), c_ref.data), kTol) << "state " << k;
+    EXPECT_LE(rel_err(data.root_wrench_W, root_ref), kTol) << "state " << k;
   }
 }
 

@@ -23,6 +23,12 @@ const MatrixX& coriolis_matrix(const Model& model, Data& data, const Eigen::Ref<
 /// model terms of the momentum residual (4).
 void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq);
+/// momentum_terms plus, in the same pass, what the forward dynamics at (q, q_dot) needs: the
+/// world-frame mass properties (as forward_kinematics, for crba_no_kinematics) and the bias
+/// torques c(q, q_dot) = C q_dot + g into data.tau with the matching ground wrench (q_ddot = 0)
+/// into data.root_wrench_W (as bias_torques). One pass instead of three.
+void momentum_and_bias_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                             const Eigen::Ref<const VectorX>& dq);
 /// As momentum_terms, for the q of the last forward_kinematics.
 void momentum_terms_no_kinematics(const Model& model, Data& data,
                                   const Eigen::Ref<const VectorX>& dq);

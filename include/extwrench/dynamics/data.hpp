@@ -23,6 +23,10 @@ struct Data {
   /// it with the parent's rotation is a column shuffle, not a 3x3 product. Axis −1: general.
   std::vector<std::array<int, 3>> placement_axis;
   std::vector<Vector3> placement_sign;
+  /// Joint i's axis when it is a coordinate axis: axis = axis_sign[i] · e_{axis_index[i]};
+  /// index −1: general axis.
+  std::vector<int> axis_index;
+  std::vector<double> axis_sign;
 
   // --- forward kinematics (forward_kinematics) ---
   std::vector<Pose> X_WB;           ///< pose of each body frame in the world
@@ -37,6 +41,7 @@ struct Data {
   std::vector<Vector6> a;           ///< spatial acceleration of body i (gravity trick included)
   std::vector<Vector6> f;           ///< spatial force transmitted by joint i to body i (f_i)
   std::vector<Vector6> h;           ///< spatial momentum of body i (I_i v_i)
+  std::vector<Vector6> bias_f;      ///< scratch of momentum_and_bias_terms: bias wrench of each subtree
 
   // --- results ---
   VectorX tau;                      ///< (n) joint torques of the last rnea / bias / gravity

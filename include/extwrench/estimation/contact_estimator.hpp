@@ -152,16 +152,19 @@ class ContactEstimator {
   int tare_count_ = 0, tare_target_ = 0;
   bool disagreement_on_ = false, have_disagreement_edge_ = false;
   double disagreement_edge_ = 0.0;
+  // Extreme eigenvectors of J Jᵀ at the last sample (cases D, E): where the next sample's
+  // power / inverse iterations start. spectrum_size_ = 3 or 6 when valid, 0 after reset.
+  Vector6 spectrum_min_ = Vector6::Zero(), spectrum_max_ = Vector6::Zero();
+  int spectrum_size_ = 0;
 
   // Scratch, sized once.
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;
   Matrix6X J_;
   ContactEstimate out_;
-  // Cholesky of B(q) for q̈̂ with storage inside the object (up to kInlineJoints joints): the
+  // LDLᵀ of B(q) for q̈̂ with storage inside the object (up to kInlineJoints joints): the
   // fixed-capacity factorisation and solves are faster than the dynamic-size ones in Data.
   static constexpr int kInlineJoints = 12;
-  Eigen::LLT<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kInlineJoints, kInlineJoints>>
-      mass_llt_;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kInlineJoints, kInlineJoints> mass_ldlt_;
 };
 
 }  // namespace extwrench

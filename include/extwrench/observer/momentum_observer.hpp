@@ -91,10 +91,13 @@ class MomentumObserver {
  private:
   friend class ContactEstimator;  // validates the sample itself, then calls advance()
 
+  /// What advance() leaves in the workspace besides the momentum terms and the poses.
+  enum class Extras { kWorldInertias, kNone, kWorldInertiasAndBias };
   /// update() without the input checks: the caller has validated (t, q, q̇, τ).
   void advance(double t, const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
-               const Eigen::Ref<const VectorX>& tau) noexcept;
-  void compute_terms(const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq) noexcept;
+               const Eigen::Ref<const VectorX>& tau, Extras extras = Extras::kWorldInertias) noexcept;
+  void compute_terms(const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
+                     Extras extras = Extras::kWorldInertias) noexcept;
   void apply_payload(int body, const Inertia* payload) noexcept;
 
   Model model_;
