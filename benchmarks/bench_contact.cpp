@@ -7,10 +7,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <kdl/chainexternalwrenchestimator.hpp>
 #include <string>
 #include <vector>
-
-#include <kdl/chainexternalwrenchestimator.hpp>
 
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "robots.hpp"
@@ -18,8 +17,8 @@
 namespace extwrench::bench {
 namespace {
 
-constexpr double kGain = 100.0;         ///< K [1/s] on every joint (KDL's estimation_gain too)
-constexpr std::size_t kWarmup = 500;    ///< samples before timing: past detection's min_duration
+constexpr double kGain = 100.0;       ///< K [1/s] on every joint (KDL's estimation_gain too)
+constexpr std::size_t kWarmup = 500;  ///< samples before timing: past detection's min_duration
 constexpr std::size_t kLatencyCalls = 1'000'000;
 constexpr std::size_t kKdlLatencyCalls = 200'000;
 
@@ -58,7 +57,9 @@ class Replay {
  public:
   Replay(const Model& model, const GeometryModel& geometry, const EstimatorOptions& options,
          const Trajectory& tr)
-      : estimator_(model, geometry, options), tr_(tr), with_sensor_(options.sensor.type != SensorType::kNone) {
+      : estimator_(model, geometry, options),
+        tr_(tr),
+        with_sensor_(options.sensor.type != SensorType::kNone) {
     ok_ = estimator_.reset(0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok();
     while (k_ < kWarmup) step();
   }
@@ -138,7 +139,8 @@ void measure_latency(benchmark::State& state, std::size_t calls, Step&& step) {
   std::sort(ns.begin(), ns.end());
   std::nth_element(clock.begin(), clock.begin() + clock.size() / 2, clock.end());
   auto at = [&](double p) {
-    return static_cast<double>(ns[std::min(ns.size() - 1, static_cast<std::size_t>(p * static_cast<double>(ns.size())))]);
+    return static_cast<double>(
+        ns[std::min(ns.size() - 1, static_cast<std::size_t>(p * static_cast<double>(ns.size())))]);
   };
   state.counters["calls"] = static_cast<double>(calls);
   state.counters["min_ns"] = static_cast<double>(ns.front());

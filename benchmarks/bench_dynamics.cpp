@@ -36,7 +36,8 @@ void BM_Rnea_Ours(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_Rnea_Ours);
 
@@ -54,7 +55,8 @@ void BM_RneaBaseWrench_Ours(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_RneaBaseWrench_Ours);
 
@@ -71,7 +73,8 @@ void BM_Rnea_Kdl(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_Rnea_Kdl);
 
@@ -86,7 +89,8 @@ void BM_MassMatrix_Ours(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_MassMatrix_Ours);
 
@@ -101,7 +105,8 @@ void BM_MassMatrix_Kdl(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_MassMatrix_Kdl);
 
@@ -118,7 +123,8 @@ void BM_Jacobian_Ours(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_Jacobian_Ours);
 
@@ -133,7 +139,8 @@ void BM_Jacobian_Kdl(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_Jacobian_Kdl);
 
@@ -151,7 +158,8 @@ void BM_MomentumTerms_Ours(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_MomentumTerms_Ours);
 
@@ -171,7 +179,8 @@ void BM_MomentumTerms_Kdl(benchmark::State& state) {
   };
   std::size_t k = 0;
   for (auto _ : state) call(k++);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_MomentumTerms_Kdl);
 

@@ -37,7 +37,8 @@ void BM_ExtWrench_Kdl(benchmark::State& state) {
     benchmark::DoNotOptimize(wrench.force.data);
   };
   for (auto _ : state) call(0);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_ExtWrench_Kdl);
 
@@ -58,7 +59,8 @@ void BM_Residual_Ours(benchmark::State& state) {
     ++k;
   };
   for (auto _ : state) call(0);
-  state.counters["allocs"] = allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_Residual_Ours);
 

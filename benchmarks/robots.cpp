@@ -2,14 +2,13 @@
 
 #include <cmath>
 #include <filesystem>
+#include <kdl/chainidsolver_recursive_newton_euler.hpp>
+#include <kdl/tree.hpp>
+#include <kdl_parser/kdl_parser.hpp>
 #include <memory>
 #include <numbers>
 #include <random>
 #include <stdexcept>
-
-#include <kdl/chainidsolver_recursive_newton_euler.hpp>
-#include <kdl/tree.hpp>
-#include <kdl_parser/kdl_parser.hpp>
 
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -24,9 +23,12 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kAlpha[7] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0};
 constexpr double kD[7] = {0, 0, 0.40, 0, 0.39, 0, 0.078};
 constexpr double kMass[7] = {2.7, 2.7, 2.7, 2.7, 2.7, 1.7, 0.3};
-constexpr double kComCm[7][3] = {{0.1340, -8.7777, 2.6220}, {0.1340, 2.6220, 8.7777},
-                                 {0.1340, 8.7777, 2.6220},  {0.1340, 2.6220, 8.7777},
-                                 {0.1340, -8.7777, 2.6220}, {0, 0.5, 0},
+constexpr double kComCm[7][3] = {{0.1340, -8.7777, 2.6220},
+                                 {0.1340, 2.6220, 8.7777},
+                                 {0.1340, 8.7777, 2.6220},
+                                 {0.1340, 2.6220, 8.7777},
+                                 {0.1340, -8.7777, 2.6220},
+                                 {0, 0.5, 0},
                                  {0, 0, -2.0}};
 // Ixx Ixy Ixz Iyy Iyz Izz [g m^2], about the CoM, DH frame i axes.
 constexpr double kInertia[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
@@ -85,8 +87,8 @@ KDL::Chain paper_arm_chain_from_dh() {
   for (int k = 0; k < 7; ++k) {
     const double* c = kInertia[k];
     // KDL: inertia in the segment's tip frame (DH frame i), rotational part about the CoM.
-    const KDL::RotationalInertia I(c[0] * 1e-3, c[3] * 1e-3, c[5] * 1e-3, c[1] * 1e-3,
-                                   c[2] * 1e-3, c[4] * 1e-3);
+    const KDL::RotationalInertia I(c[0] * 1e-3, c[3] * 1e-3, c[5] * 1e-3, c[1] * 1e-3, c[2] * 1e-3,
+                                   c[4] * 1e-3);
     const KDL::Vector com(kComCm[k][0] * 1e-2, kComCm[k][1] * 1e-2, kComCm[k][2] * 1e-2);
     chain.addSegment(KDL::Segment("link" + std::to_string(k + 1), KDL::Joint(KDL::Joint::RotZ),
                                   KDL::Frame::DH(0.0, kAlpha[k], kD[k], 0.0),
@@ -133,7 +135,8 @@ bool has_shapes(const GeometryModel& g, int nb) {
 
 PaperArm load_paper_arm() {
   PaperArm arm;
-  const std::filesystem::path urdf = std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf";
+  const std::filesystem::path urdf =
+      std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf";
   if (std::filesystem::exists(urdf)) {
     RobotDescription robot = load_urdf(urdf);
     arm.model = std::move(robot.model);
@@ -164,8 +167,8 @@ PaperArm load_paper_arm() {
 
 void check_same_robot(const PaperArm& arm, const StatePool& pool) {
   Data data(arm.model);
-  KDL::ChainIdSolver_RNE rne(arm.chain, KDL::Vector(arm.model.gravity.x(), arm.model.gravity.y(),
-                                                    arm.model.gravity.z()));
+  KDL::ChainIdSolver_RNE rne(
+      arm.chain, KDL::Vector(arm.model.gravity.x(), arm.model.gravity.y(), arm.model.gravity.z()));
   const int n = arm.model.nq();
   if (static_cast<int>(arm.chain.getNrOfJoints()) != n) {
     throw std::runtime_error("KDL chain and model have different joint counts");
@@ -239,7 +242,8 @@ Trajectory make_trajectory(const Model& model, const ContactSpec& contact_spec) 
     if (k == 0) tr.X_WS = sensor ? frame_pose(model, data, *sensor) : Pose::identity();
     const Pose& X_WB = data.X_WB[static_cast<std::size_t>(contact_spec.body)];
     const ExternalWrench contact{contact_spec.body, X_WB.rotation * contact_spec.force_B,
-                                 X_WB.act(contact_spec.point_B), X_WB.rotation * contact_spec.moment_B};
+                                 X_WB.act(contact_spec.point_B),
+                                 X_WB.rotation * contact_spec.moment_B};
     rnea_no_kinematics(model, data, dq, ddq, std::span<const ExternalWrench>(&contact, 1));
     tr.q.push_back(q);
     tr.dq.push_back(dq);
@@ -258,8 +262,9 @@ Trajectory make_trajectory(const Model& model, const ContactSpec& contact_spec) 
 }
 
 std::unique_ptr<MeshArm> load_panda() {
-  const std::filesystem::path urdf = std::filesystem::path(EXTWRENCH_SHARED_DIR) /
-                                     "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
+  const std::filesystem::path urdf =
+      std::filesystem::path(EXTWRENCH_SHARED_DIR) /
+      "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
   if (!std::filesystem::exists(urdf)) return nullptr;
   RobotDescription robot = load_urdf(urdf);
   auto arm = std::make_unique<MeshArm>();
@@ -280,7 +285,8 @@ std::unique_ptr<MeshArm> load_panda() {
   g.body_shapes.resize(static_cast<std::size_t>(keep));
   for (const CollisionShape& shape : robot.geometry.shapes) {
     if (shape.body >= keep) continue;
-    g.body_shapes[static_cast<std::size_t>(shape.body)].push_back(static_cast<int>(g.shapes.size()));
+    g.body_shapes[static_cast<std::size_t>(shape.body)].push_back(
+        static_cast<int>(g.shapes.size()));
     g.shapes.push_back(shape);
   }
   arm->model = std::move(m);
@@ -316,8 +322,9 @@ ContactSpec mesh_contact(const GeometryModel& geometry, int body) {
 const Trajectory& link6_trajectory() {
   // On link 6's capsule (radius 0.065 m, axis z), pushing inward (−x) with a tangential part
   // along z that gives joint 6 (axis −y) about 2 N m, well over the default τ_min = 1 N m.
-  static const Trajectory tr = make_trajectory(
-      paper_arm().model, {6, Vector3(0.065, 0.0, 0.01), Vector3(-15.0, 0.0, 30.0), Vector3::Zero()});
+  static const Trajectory tr =
+      make_trajectory(paper_arm().model,
+                      {6, Vector3(0.065, 0.0, 0.01), Vector3(-15.0, 0.0, 30.0), Vector3::Zero()});
   return tr;
 }
 
@@ -336,7 +343,8 @@ const Trajectory* panda_trajectory() {
   static const std::unique_ptr<Trajectory> tr = []() -> std::unique_ptr<Trajectory> {
     const MeshArm* arm = panda_arm();
     if (arm == nullptr) return nullptr;
-    return std::make_unique<Trajectory>(make_trajectory(arm->model, mesh_contact(arm->geometry, 6)));
+    return std::make_unique<Trajectory>(
+        make_trajectory(arm->model, mesh_contact(arm->geometry, 6)));
   }();
   return tr.get();
 }

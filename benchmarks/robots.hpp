@@ -3,12 +3,11 @@
 #pragma once
 
 #include <cstddef>
+#include <kdl/chain.hpp>
+#include <kdl/jntarray.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <kdl/chain.hpp>
-#include <kdl/jntarray.hpp>
 
 #include "alloc_counter.hpp"
 #include "extwrench/geometry/shapes.hpp"
@@ -22,9 +21,9 @@ namespace extwrench::bench {
 /// RNE and ours agree on the seeded states (throws otherwise).
 struct PaperArm {
   Model model;
-  GeometryModel geometry;    ///< collision shapes (capsules); see paper_arm()
-  KDL::Chain chain;          ///< root (link 0) to the flange
-  std::string source;        ///< where the robot came from, printed in the benchmark context
+  GeometryModel geometry;  ///< collision shapes (capsules); see paper_arm()
+  KDL::Chain chain;        ///< root (link 0) to the flange
+  std::string source;      ///< where the robot came from, printed in the benchmark context
 };
 const PaperArm& paper_arm();
 
@@ -63,9 +62,9 @@ struct Trajectory {
   static constexpr std::size_t kNumSamples = 2000;  ///< 2 s: the frequencies are 0.5 and 1 Hz
   double dt = 1e-3;
   ContactSpec contact;
-  Pose X_WS;                                   ///< base sensor frame ("sensor", else the root)
+  Pose X_WS;  ///< base sensor frame ("sensor", else the root)
   std::vector<VectorX> q, dq, ddq, tau;
-  std::vector<Vector6> ft_S;                   ///< base F/T reading [f_m; n_m] in the sensor frame
+  std::vector<Vector6> ft_S;  ///< base F/T reading [f_m; n_m] in the sensor frame
   std::vector<KDL::JntArray> kq, kdq, ktau;
 };
 /// Paper arm, pure force on link 6 pushing on its capsule (the paper's contact link).

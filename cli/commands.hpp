@@ -7,12 +7,11 @@
 // errors, or UsageError thrown by a callback).
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 #include "extwrench/core/types.hpp"
 #include "extwrench/io/robot_loader.hpp"
@@ -40,8 +39,8 @@ void register_simulate(CLI::App& app);
 void add_package_path_option(CLI::App& sub, std::vector<std::filesystem::path>& dirs);
 
 /// Loads a URDF or DH YAML with those package directories (and ROS_PACKAGE_PATH).
-[[nodiscard]] RobotDescription load_robot_file(const std::filesystem::path& path,
-                                               const std::vector<std::filesystem::path>& package_path);
+[[nodiscard]] RobotDescription load_robot_file(
+    const std::filesystem::path& path, const std::vector<std::filesystem::path>& package_path);
 
 /// The base sensor pose X_WS used when none is given: the frame named "sensor" if the model
 /// has one (it must be on link 0), else the root link's origin, aligned with it.

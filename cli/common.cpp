@@ -62,7 +62,8 @@ RobotDescription load_robot_file(const std::filesystem::path& path,
 Pose default_sensor_pose(const Model& model, std::string* description) {
   const auto frame = model.find_frame("sensor");
   if (!frame) {
-    if (description) *description = "the root link's origin ('" + model.bodies[0].name + "'), aligned with it";
+    if (description)
+      *description = "the root link's origin ('" + model.bodies[0].name + "'), aligned with it";
     return Pose::identity();
   }
   const Frame& f = model.frames[static_cast<std::size_t>(*frame)];
@@ -85,6 +86,8 @@ std::string fmt(double value) {
   return text.data();
 }
 
-std::string fmt(const Vector3& v) { return "(" + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + ")"; }
+std::string fmt(const Vector3& v) {
+  return "(" + fmt(v.x()) + ", " + fmt(v.y()) + ", " + fmt(v.z()) + ")";
+}
 
 }  // namespace extwrench::cli

@@ -49,8 +49,9 @@ void run_dynamics(const DynamicsOptions& opt) {
   const int n = model.nq();
   const Pose X_WS = given_pose ? *given_pose : default_sensor_pose(model, nullptr);
 
-  std::unique_ptr<CsvReader> reader = opt.in == "-" ? std::make_unique<CsvReader>(std::cin, "<stdin>")
-                                                    : std::make_unique<CsvReader>(std::filesystem::path(opt.in));
+  std::unique_ptr<CsvReader> reader =
+      opt.in == "-" ? std::make_unique<CsvReader>(std::cin, "<stdin>")
+                    : std::make_unique<CsvReader>(std::filesystem::path(opt.in));
 
   // Resolve every column once; report all that are missing together.
   const std::vector<std::string> wanted = state_columns(n);
@@ -62,19 +63,21 @@ void run_dynamics(const DynamicsOptions& opt) {
     index.push_back(c.value_or(-1));
   }
   if (!missing.empty()) {
-    throw Error(reader->name() + ":1: missing column(s) " + missing + " (the robot has " + std::to_string(n) +
-                " joints, so the header needs t, q1..q" + std::to_string(n) + ", dq1..dq" + std::to_string(n) +
-                ", ddq1..ddq" + std::to_string(n) + ")");
+    throw Error(reader->name() + ":1: missing column(s) " + missing + " (the robot has " +
+                std::to_string(n) + " joints, so the header needs t, q1..q" + std::to_string(n) +
+                ", dq1..dq" + std::to_string(n) + ", ddq1..ddq" + std::to_string(n) + ")");
   }
   std::string extra;
   for (const std::string& name : reader->header()) {
-    if (std::find(wanted.begin(), wanted.end(), name) == wanted.end()) extra += (extra.empty() ? "" : ", ") + name;
+    if (std::find(wanted.begin(), wanted.end(), name) == wanted.end())
+      extra += (extra.empty() ? "" : ", ") + name;
   }
   if (!extra.empty()) std::cerr << "extwrench dynamics: ignoring column(s) " << extra << "\n";
 
   std::unique_ptr<CsvWriter> writer =
-      opt.out == "-" ? std::make_unique<CsvWriter>(std::cout, output_columns(n), "<stdout>")
-                     : std::make_unique<CsvWriter>(std::filesystem::path(opt.out), output_columns(n));
+      opt.out == "-"
+          ? std::make_unique<CsvWriter>(std::cout, output_columns(n), "<stdout>")
+          : std::make_unique<CsvWriter>(std::filesystem::path(opt.out), output_columns(n));
 
   Data data(model);
   VectorX q(n), dq(n), ddq(n);
@@ -105,7 +108,8 @@ void run_dynamics(const DynamicsOptions& opt) {
   }
   writer->close();
   if (opt.out != "-") {
-    std::cerr << "extwrench dynamics: " << reader->rows_read() << " row(s) written to " << opt.out << "\n";
+    std::cerr << "extwrench dynamics: " << reader->rows_read() << " row(s) written to " << opt.out
+              << "\n";
   }
 }
 
@@ -113,10 +117,10 @@ void run_dynamics(const DynamicsOptions& opt) {
 
 void register_dynamics(CLI::App& app) {
   auto opt = std::make_shared<DynamicsOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "dynamics",
-      "Joint torques (inverse dynamics) and the predicted base force/torque sensor reading for each "
-      "row of a CSV of states");
+  CLI::App* sub = app.add_subcommand("dynamics",
+                                     "Joint torques (inverse dynamics) and the predicted base "
+                                     "force/torque sensor reading for each "
+                                     "row of a CSV of states");
   sub->add_option("--robot", opt->robot, "Robot file: URDF (.urdf, .xml) or DH table (.yaml, .yml)")
       ->required()
       ->type_name("FILE");
@@ -125,19 +129,24 @@ void register_dynamics(CLI::App& app) {
                   "/s, /s^2], any order; other columns are ignored; '-' reads stdin")
       ->required()
       ->type_name("STATES.csv");
-  sub->add_option("--out", opt->out,
-                  "CSV written with t, tau1..taun [N m or N], fs_x fs_y fs_z [N], ms_x ms_y ms_z [N m]; "
-                  "'-' writes to stdout")
+  sub->add_option(
+         "--out", opt->out,
+         "CSV written with t, tau1..taun [N m or N], fs_x fs_y fs_z [N], ms_x ms_y ms_z [N m]; "
+         "'-' writes to stdout")
       ->required()
       ->type_name("OUT.csv");
-  CLI::Option* pose_option = sub->add_option("--sensor-pose", opt->sensor_pose,
-                  "Pose of the base sensor in the root frame, \"x y z roll pitch yaw\" (m, rad, URDF "
-                  "rpy). Default: the model's frame 'sensor', else the root link's origin, aligned")
-      ->type_name("\"X Y Z R P Y\"");
+  CLI::Option* pose_option =
+      sub->add_option(
+             "--sensor-pose", opt->sensor_pose,
+             "Pose of the base sensor in the root frame, \"x y z roll pitch yaw\" (m, rad, URDF "
+             "rpy). Default: the model's frame 'sensor', else the root link's origin, aligned")
+          ->type_name("\"X Y Z R P Y\"");
   add_package_path_option(*sub, opt->package_path);
   sub->footer(
-      "\nThe reading is what the robot discharges onto the sensor: force and moment about the sensor\n"
-      "origin, in the sensor frame (link 0's weight included). Numbers are written in the shortest\n"
+      "\nThe reading is what the robot discharges onto the sensor: force and moment about the "
+      "sensor\n"
+      "origin, in the sensor frame (link 0's weight included). Numbers are written in the "
+      "shortest\n"
       "form that reads back to the same double.\n\n"
       "Example:\n"
       "  extwrench dynamics --robot models/paper_arm.yaml --in states.csv --out predicted.csv");

@@ -1,8 +1,8 @@
 // extwrench estimate: replays a robot log (real or simulated) through the contact estimator.
+#include <unistd.h>
+
 #include <iostream>
 #include <memory>
-
-#include <unistd.h>
 
 #include "commands.hpp"
 #include "extwrench/core/error.hpp"
@@ -48,7 +48,8 @@ void run_estimate(const EstimateOptions& opt) {
   load.package_path = opt.package_path;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(opt.log, ec)) throw Error(opt.log.string() + ": no such log file");
+  if (!std::filesystem::is_regular_file(opt.log, ec))
+    throw Error(opt.log.string() + ": no such log file");
 
   ReplayOptions replay;
   replay.log = opt.log;
@@ -62,14 +63,17 @@ void run_estimate(const EstimateOptions& opt) {
   replay.figures = !opt.no_figures;
   replay.plot_points = opt.plot_points;
   replay.progress = isatty(STDERR_FILENO) != 0;
-  const ReplayResult r = replay_log(config.robot.model, config.robot.geometry, config.options, replay);
+  const ReplayResult r =
+      replay_log(config.robot.model, config.robot.geometry, config.options, replay);
 
-  std::cout << "extwrench estimate: " << r.rows << " rows -> " << (opt.out / "estimates.csv").string() << "\n";
+  std::cout << "extwrench estimate: " << r.rows << " rows -> "
+            << (opt.out / "estimates.csv").string() << "\n";
   if (r.has_truth) {
     const sim::Metrics& m = r.report.windows.front().metrics;
-    std::cout << "  metrics (" << description << "): force error RMS " << fmt(m.force.rms()) << " N, max "
-              << fmt(m.force.max) << " N; line of action RMS " << fmt(m.line.rms()) << " m; right link "
-              << fmt(100.0 * m.isolation_accuracy()) << " %; false alarms " << m.false_alarms << "\n"
+    std::cout << "  metrics (" << description << "): force error RMS " << fmt(m.force.rms())
+              << " N, max " << fmt(m.force.max) << " N; line of action RMS " << fmt(m.line.rms())
+              << " m; right link " << fmt(100.0 * m.isolation_accuracy()) << " %; false alarms "
+              << m.false_alarms << "\n"
               << "  -> " << (opt.out / "metrics.json").string() << "\n";
   }
   for (const auto& f : r.figures) std::cout << "  figure: " << f.string() << "\n";
@@ -86,18 +90,23 @@ void register_estimate(CLI::App& app) {
   sub->add_option("--config", opt->config, "Estimator configuration (YAML, docs/config.md)")
       ->required()
       ->type_name("CONFIG.yaml");
-  sub->add_option("--log", opt->log, "Robot log (CSV, docs/log_format.md)")->required()->type_name("LOG.csv");
+  sub->add_option("--log", opt->log, "Robot log (CSV, docs/log_format.md)")
+      ->required()
+      ->type_name("LOG.csv");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
-  sub->add_option("--metrics-from", opt->metrics_from, "Start of the metrics window [s] (default 0)")
+  sub->add_option("--metrics-from", opt->metrics_from,
+                  "Start of the metrics window [s] (default 0)")
       ->type_name("T");
-  sub->add_option("--metrics-to", opt->metrics_to, "End of the metrics window [s] (default: end of log)")
+  sub->add_option("--metrics-to", opt->metrics_to,
+                  "End of the metrics window [s] (default: end of log)")
       ->type_name("T");
   sub->add_option("--exclude", opt->exclude, "Exclude FROM:TO [s] from the metrics (repeatable)")
       ->type_name("FROM:TO");
   sub->add_flag("--surface-metrics", opt->surface_metrics,
                 "Report the surface-point error (when the true points lie on the links' surfaces)");
   sub->add_flag("--no-figures", opt->no_figures, "Do not draw figures (no gnuplot needed)");
-  sub->add_option("--plot-points", opt->plot_points, "Points per figure after decimation (default 2000)")
+  sub->add_option("--plot-points", opt->plot_points,
+                  "Points per figure after decimation (default 2000)")
       ->type_name("N");
   add_package_path_option(*sub, opt->package_path);
   sub->callback([opt]() { run_estimate(*opt); });

@@ -18,22 +18,29 @@ struct InfoOptions {
 
 std::string joint_type_name(JointType type) {
   switch (type) {
-    case JointType::kRevolute: return "revolute";
-    case JointType::kPrismatic: return "prismatic";
+    case JointType::kRevolute:
+      return "revolute";
+    case JointType::kPrismatic:
+      return "prismatic";
   }
   return "unknown";
 }
 
 std::string shape_text(const CollisionShape& s) {
   switch (s.type) {
-    case ShapeType::kSphere: return "sphere radius " + fmt(s.radius);
-    case ShapeType::kBox: return "box size " + fmt(s.size);
-    case ShapeType::kCylinder: return "cylinder radius " + fmt(s.radius) + " length " + fmt(s.length);
-    case ShapeType::kCapsule: return "capsule radius " + fmt(s.radius) + " length " + fmt(s.length);
+    case ShapeType::kSphere:
+      return "sphere radius " + fmt(s.radius);
+    case ShapeType::kBox:
+      return "box size " + fmt(s.size);
+    case ShapeType::kCylinder:
+      return "cylinder radius " + fmt(s.radius) + " length " + fmt(s.length);
+    case ShapeType::kCapsule:
+      return "capsule radius " + fmt(s.radius) + " length " + fmt(s.length);
     case ShapeType::kMesh: {
       std::string text = "mesh";
       if (s.mesh) {
-        text += " '" + s.mesh->path + "', " + std::to_string(s.mesh->triangles.cols()) + " triangles";
+        text +=
+            " '" + s.mesh->path + "', " + std::to_string(s.mesh->triangles.cols()) + " triangles";
       }
       if (!s.scale.isOnes()) text += ", scale " + fmt(s.scale);
       return text;
@@ -69,8 +76,10 @@ void run_info(const InfoOptions& opt) {
   const Model& model = robot.model;
   std::ostringstream out;
 
-  out << "robot: " << (model.name.empty() ? "(unnamed)" : model.name) << "  (" << opt.robot.string() << ")\n";
-  out << "joints: " << model.nq() << (model.is_serial_chain() ? ", serial chain" : ", tree") << "\n";
+  out << "robot: " << (model.name.empty() ? "(unnamed)" : model.name) << "  (" << opt.robot.string()
+      << ")\n";
+  out << "joints: " << model.nq() << (model.is_serial_chain() ? ", serial chain" : ", tree")
+      << "\n";
   out << "gravity: " << fmt(model.gravity) << " m/s^2 in the root frame\n";
 
   out << "\nBodies (links welded by fixed joints are merged into one body; mass [kg], centre of\n"
@@ -78,9 +87,10 @@ void run_info(const InfoOptions& opt) {
   for (int i = 0; i < model.num_bodies(); ++i) {
     const Body& b = model.bodies[static_cast<std::size_t>(i)];
     const Matrix3& I = b.inertia.inertia_com;
-    out << "  " << i << "  " << b.name << "  mass " << fmt(b.inertia.mass) << "  com " << fmt(b.inertia.com)
-        << "\n     ixx " << fmt(I(0, 0)) << " iyy " << fmt(I(1, 1)) << " izz " << fmt(I(2, 2)) << " ixy "
-        << fmt(I(0, 1)) << " ixz " << fmt(I(0, 2)) << " iyz " << fmt(I(1, 2)) << "\n";
+    out << "  " << i << "  " << b.name << "  mass " << fmt(b.inertia.mass) << "  com "
+        << fmt(b.inertia.com) << "\n     ixx " << fmt(I(0, 0)) << " iyy " << fmt(I(1, 1)) << " izz "
+        << fmt(I(2, 2)) << " ixy " << fmt(I(0, 1)) << " ixz " << fmt(I(0, 2)) << " iyz "
+        << fmt(I(1, 2)) << "\n";
   }
   out << "total mass: " << fmt(model.total_mass()) << " kg\n";
 
@@ -89,8 +99,9 @@ void run_info(const InfoOptions& opt) {
     const Joint& j = model.joints[static_cast<std::size_t>(i)];
     const int parent = model.parents[static_cast<std::size_t>(i)];
     out << "  q" << i << "  " << j.name << "  " << joint_type_name(j.type) << "  "
-        << model.bodies[static_cast<std::size_t>(parent)].name << " -> " << model.bodies[static_cast<std::size_t>(i)].name
-        << "  axis " << fmt(j.axis) << "\n     " << limits_text(j) << "\n";
+        << model.bodies[static_cast<std::size_t>(parent)].name << " -> "
+        << model.bodies[static_cast<std::size_t>(i)].name << "  axis " << fmt(j.axis) << "\n     "
+        << limits_text(j) << "\n";
   }
 
   out << "\nFrames (every link and named frame; pose in its body's frame, xyz [m], rpy [rad]):\n";
@@ -112,7 +123,8 @@ void run_info(const InfoOptions& opt) {
   if (robot.geometry.shapes.empty()) out << "  none\n";
   for (const CollisionShape& s : robot.geometry.shapes) {
     out << "  " << model.bodies[static_cast<std::size_t>(s.body)].name;
-    if (!s.link.empty() && s.link != model.bodies[static_cast<std::size_t>(s.body)].name) out << " (link " << s.link << ")";
+    if (!s.link.empty() && s.link != model.bodies[static_cast<std::size_t>(s.body)].name)
+      out << " (link " << s.link << ")";
     out << ": " << shape_text(s) << "  " << pose_text(s.placement) << "\n";
   }
   std::cout << out.str();
@@ -122,8 +134,9 @@ void run_info(const InfoOptions& opt) {
 
 void register_info(CLI::App& app) {
   auto opt = std::make_shared<InfoOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "info", "Print what a robot file contains: links, joints, masses, frames, sensor pose, collision shapes");
+  CLI::App* sub = app.add_subcommand("info",
+                                     "Print what a robot file contains: links, joints, masses, "
+                                     "frames, sensor pose, collision shapes");
   sub->add_option("ROBOT", opt->robot, "Robot file: URDF (.urdf, .xml) or DH table (.yaml, .yml)")
       ->required()
       ->type_name("FILE");

@@ -62,7 +62,8 @@ int main(int argc, char** argv) {
     app.exit(e);
     return kExitUsageError;
   } catch (const extwrench::cli::UsageError& e) {
-    std::cerr << "extwrench: usage error: " << e.what() << "\nRun with --help for more information.\n";
+    std::cerr << "extwrench: usage error: " << e.what()
+              << "\nRun with --help for more information.\n";
     return kExitUsageError;
   } catch (const extwrench::Error& e) {
     std::cerr << "extwrench: error: " << e.what() << "\n";

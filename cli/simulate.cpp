@@ -1,12 +1,12 @@
 // extwrench simulate: runs a scenario (docs/simulation.md) — closed-loop simulation, the log, the
 // estimators replayed on it — and prints a table of the metrics.
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
-
-#include <unistd.h>
 
 #include "commands.hpp"
 #include "extwrench/core/error.hpp"
@@ -45,15 +45,19 @@ void run_simulate(const SimulateOptions& opt) {
   run.progress = isatty(STDERR_FILENO) != 0;
   const std::vector<SeedResult> results = run_scenario(scenario, opt.out, run);
 
-  std::printf("\nextwrench simulate: %s, %zu seed(s), %.3g s at %.3g ms, dynamic parameters ±%g %%\n",
-              opt.scenario.string().c_str(), results.size(), scenario.simulation.duration,
-              1e3 * scenario.simulation.sample_time, 100.0 * scenario.model_error);
+  std::printf(
+      "\nextwrench simulate: %s, %zu seed(s), %.3g s at %.3g ms, dynamic parameters ±%g %%\n",
+      opt.scenario.string().c_str(), results.size(), scenario.simulation.duration,
+      1e3 * scenario.simulation.sample_time, 100.0 * scenario.model_error);
   const std::string from = cell(scenario.metrics_from, "%g");
-  std::printf("Metrics after t = %s s; 'F RMS*' excludes ±%g s around the peak of cond(J of O_l), l = %s.\n\n",
-              from.c_str(), scenario.singularity_half_width,
-              scenario.singularity_link.empty() ? "-" : scenario.singularity_link.c_str());
-  std::printf("%-12s %6s %10s %9s %9s %10s %10s %9s %7s %9s %12s\n", "scheme", "seed", "F RMS [N]", "F max [N]",
-              "F RMS*[N]", "line RMS", "line max", "link [%]", "missed", "false al.", "peak cond");
+  std::printf(
+      "Metrics after t = %s s; 'F RMS*' excludes ±%g s around the peak of cond(J of O_l), l = "
+      "%s.\n\n",
+      from.c_str(), scenario.singularity_half_width,
+      scenario.singularity_link.empty() ? "-" : scenario.singularity_link.c_str());
+  std::printf("%-12s %6s %10s %9s %9s %10s %10s %9s %7s %9s %12s\n", "scheme", "seed", "F RMS [N]",
+              "F max [N]", "F RMS*[N]", "line RMS", "line max", "link [%]", "missed", "false al.",
+              "peak cond");
   for (const SchemeSpec& scheme : scenario.schemes) {
     double worst_f = 0.0, worst_f_outside = 0.0, worst_line = 0.0, worst_link = 1.0;
     for (const SeedResult& r : results) {
@@ -63,10 +67,12 @@ void run_simulate(const SimulateOptions& opt) {
         const NamedMetrics* b = window_named(sr.replay, "outside_singularity");
         if (!a) continue;
         const sim::Metrics& m = a->metrics;
-        std::printf("%-12s %6llu %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n", scheme.name.c_str(),
-                    static_cast<unsigned long long>(r.seed), cell(m.force.rms(), "%.3f").c_str(),
-                    cell(m.force.max, "%.2f").c_str(), b ? cell(b->metrics.force.rms(), "%.3f").c_str() : "-",
-                    cell(m.line.rms(), "%.4f").c_str(), cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
+        std::printf("%-12s %6llu %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n",
+                    scheme.name.c_str(), static_cast<unsigned long long>(r.seed),
+                    cell(m.force.rms(), "%.3f").c_str(), cell(m.force.max, "%.2f").c_str(),
+                    b ? cell(b->metrics.force.rms(), "%.3f").c_str() : "-",
+                    cell(m.line.rms(), "%.4f").c_str(),
+                    cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
                     cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
                     cell(r.peak_condition, "%.3g").c_str());
         worst_f = std::max(worst_f, m.force.rms());
@@ -81,12 +87,14 @@ void run_simulate(const SimulateOptions& opt) {
                   cell(worst_line, "%.4f").c_str(), "", cell(100.0 * worst_link, "%.2f").c_str());
     }
   }
-  std::printf("\nOutputs (per seed: log.csv, model_estimator.urdf; per scheme: config.yaml, estimates.csv, "
-              "metrics.json, figures):\n");
+  std::printf(
+      "\nOutputs (per seed: log.csv, model_estimator.urdf; per scheme: config.yaml, estimates.csv, "
+      "metrics.json, figures):\n");
   for (const SeedResult& r : results) {
     std::printf("  %s\n", r.dir.string().c_str());
   }
-  if (!results.empty() && !results.front().schemes.empty() && !results.front().schemes.front().replay.figures.empty()) {
+  if (!results.empty() && !results.front().schemes.empty() &&
+      !results.front().schemes.front().replay.figures.empty()) {
     std::printf("Figures, e.g.:\n");
     for (const SchemeResult& sr : results.front().schemes) {
       for (const auto& f : sr.replay.figures) std::printf("  %s\n", f.string().c_str());
@@ -98,11 +106,13 @@ void run_simulate(const SimulateOptions& opt) {
 
 void register_simulate(CLI::App& app) {
   auto opt = std::make_shared<SimulateOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "simulate",
-      "Run a simulation scenario: closed-loop robot, forces and sensors, then every estimator scheme "
-      "replayed on the log it wrote (docs/simulation.md)");
-  sub->add_option("scenario", opt->scenario, "Scenario file (YAML)")->required()->type_name("SCENARIO.yaml");
+  CLI::App* sub = app.add_subcommand("simulate",
+                                     "Run a simulation scenario: closed-loop robot, forces and "
+                                     "sensors, then every estimator scheme "
+                                     "replayed on the log it wrote (docs/simulation.md)");
+  sub->add_option("scenario", opt->scenario, "Scenario file (YAML)")
+      ->required()
+      ->type_name("SCENARIO.yaml");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
   sub->add_flag("--no-figures", opt->no_figures, "Do not draw figures (no gnuplot needed)");
   add_package_path_option(*sub, opt->package_path);

@@ -9,8 +9,8 @@
 //   example_estimator_loop [path/to/robot.urdf [K]]
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <string>
 
@@ -24,7 +24,7 @@ using namespace extwrench;
 
 namespace {
 
-constexpr double kDt = 1e-3;     // 1 kHz
+constexpr double kDt = 1e-3;  // 1 kHz
 constexpr double kT_on = 1.0, kT_off = 2.5, kT_end = 3.0;
 
 struct Truth {
@@ -41,8 +41,8 @@ struct Truth {
 };
 
 /// q̈ of the simulated robot: B q̈ = τ + J_pᵀ W − c, with the wrench applied through RNEA.
-VectorX acceleration(const Model& m, Data& d, const Truth& truth, const VectorX& q, const VectorX& dq,
-                     const VectorX& tau) {
+VectorX acceleration(const Model& m, Data& d, const Truth& truth, const VectorX& q,
+                     const VectorX& dq, const VectorX& tau) {
   forward_kinematics(m, d, q);
   ExternalWrench w;
   const int nw = truth.wrench(d, w);
@@ -52,14 +52,16 @@ VectorX acceleration(const Model& m, Data& d, const Truth& truth, const VectorX&
     tau_ext = rnea(m, d, q, dq, zero);  // copy: rnea returns a reference into d
     tau_ext -= rnea(m, d, q, dq, zero, std::span<const ExternalWrench>(&w, 1));
   }
-  if (!forward_dynamics(m, d, q, dq, tau + tau_ext)) throw std::runtime_error("mass matrix not positive definite");
+  if (!forward_dynamics(m, d, q, dq, tau + tau_ext))
+    throw std::runtime_error("mass matrix not positive definite");
   return d.ddq;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::string path = argc > 1 ? argv[1] : std::string(EXTWRENCH_MODELS_DIR) + "/paper_arm.urdf";
+  const std::string path =
+      argc > 1 ? argv[1] : std::string(EXTWRENCH_MODELS_DIR) + "/paper_arm.urdf";
   const double gain = argc > 2 ? std::atof(argv[2]) : 100.0;
   const RobotDescription robot = load_robot(path);
   const Model& model = robot.model;
@@ -106,8 +108,10 @@ int main(int argc, char** argv) {
     const double h = kDt;
     const VectorX a1 = acceleration(model, sim, truth, q, dq, tau);
     const VectorX a2 = acceleration(model, sim, truth, q + 0.5 * h * dq, dq + 0.5 * h * a1, tau);
-    const VectorX a3 = acceleration(model, sim, truth, q + 0.5 * h * (dq + 0.5 * h * a1), dq + 0.5 * h * a2, tau);
-    const VectorX a4 = acceleration(model, sim, truth, q + h * (dq + 0.5 * h * a2), dq + h * a3, tau);
+    const VectorX a3 =
+        acceleration(model, sim, truth, q + 0.5 * h * (dq + 0.5 * h * a1), dq + 0.5 * h * a2, tau);
+    const VectorX a4 =
+        acceleration(model, sim, truth, q + h * (dq + 0.5 * h * a2), dq + h * a3, tau);
     q += h * dq + h * h / 6 * (a1 + a2 + a3);
     dq += h / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
     t = k * kDt;
@@ -124,7 +128,8 @@ int main(int argc, char** argv) {
     // --- the estimator: one real-time update ---
     const auto start = std::chrono::steady_clock::now();
     const Status status = estimator.update(t, q, dq, tau, reading);
-    const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+    const double us =
+        std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
     worst_us = std::max(worst_us, us);
     total_us += us;
     ++updates;
@@ -135,12 +140,13 @@ int main(int argc, char** argv) {
     if (k % 100 == 0) {
       const ContactEstimate& e = estimator.result();
       const double err = nw > 0 ? (e.force_W - w.force_W).norm() : std::nan("");
-      std::printf("%6.2f %7d %5s [%7.2f %7.2f %7.2f] [%7.3f %7.3f %7.3f] %8.3f  %s\n", t, e.contact ? 1 : 0,
-                  e.contact ? std::string(e.link_name).c_str() : "-", e.force_W.x(), e.force_W.y(), e.force_W.z(),
-                  e.point_W.x(), e.point_W.y(), e.point_W.z(), err, describe_flags(e.flags).c_str());
+      std::printf("%6.2f %7d %5s [%7.2f %7.2f %7.2f] [%7.3f %7.3f %7.3f] %8.3f  %s\n", t,
+                  e.contact ? 1 : 0, e.contact ? std::string(e.link_name).c_str() : "-",
+                  e.force_W.x(), e.force_W.y(), e.force_W.z(), e.point_W.x(), e.point_W.y(),
+                  e.point_W.z(), err, describe_flags(e.flags).c_str());
     }
   }
-  std::printf("estimator update: mean %.2f us, worst %.2f us over %d samples\n", total_us / updates, worst_us,
-              updates);
+  std::printf("estimator update: mean %.2f us, worst %.2f us over %d samples\n", total_us / updates,
+              worst_us, updates);
   return 0;
 }

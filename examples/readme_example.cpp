@@ -19,7 +19,8 @@ int main(int argc, char** argv) {
   Data data(model);                                 // workspace: all buffers sized once
 
   const int n = model.nq();
-  const VectorX q = VectorX::Constant(n, 0.3), dq = VectorX::Constant(n, 0.1), ddq = VectorX::Zero(n);
+  const VectorX q = VectorX::Constant(n, 0.3), dq = VectorX::Constant(n, 0.1),
+                ddq = VectorX::Zero(n);
 
   // A 20 N push along world x at a point of the last link (no allocation from here on).
   const ExternalWrench push{.body = n, .force_W = {20.0, 0.0, 0.0}, .point_W = {0.1, 0.0, 1.0}};

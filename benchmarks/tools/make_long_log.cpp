@@ -23,7 +23,12 @@ int main(int argc, char** argv) {
   try {
     using namespace extwrench;
     constexpr int n = 7;
-    LogLayout layout{.n = n, .velocity = true, .force = true, .moment = true, .truth = true, .true_tau_ext = true};
+    LogLayout layout{.n = n,
+                     .velocity = true,
+                     .force = true,
+                     .moment = true,
+                     .truth = true,
+                     .true_tau_ext = true};
     LogWriter writer(argv[2], layout);
     sim::Sample s;
     s.q.resize(n);

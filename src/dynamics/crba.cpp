@@ -77,8 +77,8 @@ void momentum_terms_no_kinematics(const Model& model, Data& data,
   for (int i = 1; i < nb; ++i) data.v[i] = data.v[model.parents[i]] + data.S[i] * dq[i - 1];
   // Backward accumulation over subtrees, reusing f as the subtree momentum H_i.
   for (int i = 0; i < nb; ++i) {
-    data.h[i] = detail::inertia_times(data.mass[i], data.first_moment_W[i], data.inertia_O_W[i],
-                                      data.v[i]);
+    data.h[i] =
+        detail::inertia_times(data.mass[i], data.first_moment_W[i], data.inertia_O_W[i], data.v[i]);
     data.f[i] = data.h[i];  // H_i = sum of h_k over sub(i)
     data.composite_mass[i] = data.mass[i];
     data.composite_first_moment[i] = data.first_moment_W[i];
@@ -187,7 +187,8 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
       data.a[i].tail<3>() = w_dot;
       // Newton-Euler about the CoM (see rnea): F = m c_ddot, N_c = I_c,W w_dot + w x I_c,W w.
       const Vector3 F = inertia.mass * (a_O + w_dot.cross(c) + w.cross(v_c));
-      const Vector3 N = R * (inertia.inertia_com * (R.transpose() * w_dot)) + w.cross(Iw) + c.cross(F);
+      const Vector3 N =
+          R * (inertia.inertia_com * (R.transpose() * w_dot)) + w.cross(Iw) + c.cross(F);
       data.bias_f[i].head<3>() = F;
       data.bias_f[i].tail<3>() = N;
       detail::world_mass_properties_of(model, data, i);

@@ -149,8 +149,8 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
       data.a[i] = data.a[p] + s * ddq[i - 1] + detail::cross_motion(data.v[p], vj);
     }
     // (7)-(8) in spatial form: f_i = I_i a_i + v_i x* I_i v_i
-    const Vector6 hi = detail::inertia_times(data.mass[i], data.first_moment_W[i],
-                                             data.inertia_O_W[i], data.v[i]);
+    const Vector6 hi =
+        detail::inertia_times(data.mass[i], data.first_moment_W[i], data.inertia_O_W[i], data.v[i]);
     data.f[i] = detail::inertia_times(data.mass[i], data.first_moment_W[i], data.inertia_O_W[i],
                                       data.a[i]) +
                 detail::cross_force(data.v[i], hi);

@@ -34,7 +34,8 @@ inline Vector6 cross_force(const Vector6& v, const Vector6& f) {
 
 /// Spatial inertia (about the world origin) applied to a motion: I v with mass m, first moment
 /// h = m c and rotational inertia I_O about the origin: [m v_O - h x w; h x v_O + I_O w].
-inline Vector6 inertia_times(double m, const Vector3& h, const Matrix3& inertia_O, const Vector6& v) {
+inline Vector6 inertia_times(double m, const Vector3& h, const Matrix3& inertia_O,
+                             const Vector6& v) {
   Vector6 out;
   out.head<3>() = m * lin(v) - h.cross(ang(v));
   out.tail<3>() = h.cross(lin(v)) + inertia_O * ang(v);
@@ -139,7 +140,8 @@ inline Matrix3 axis_rotation(const Vector3& axis, double angle) {
 }
 
 /// joint_kinematics stored into data.X_WB[i] and data.S[i].
-[[gnu::always_inline]] inline void joint_kinematics(const Model& model, Data& data, int i, double qi) {
+[[gnu::always_inline]] inline void joint_kinematics(const Model& model, Data& data, int i,
+                                                    double qi) {
   Matrix3 R;
   Vector3 p;
   Vector3 s_lin;
@@ -178,7 +180,8 @@ inline void world_mass_properties_of(const Model& model, Data& data, int i) {
 
 /// Poses (data.X_WB) and motion subspaces (data.S) of all bodies: forward_kinematics without
 /// the world-frame mass properties.
-inline void poses_and_subspaces(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+inline void poses_and_subspaces(const Model& model, Data& data,
+                                const Eigen::Ref<const VectorX>& q) {
   const int nb = model.num_bodies();
   data.X_WB[0] = Pose{};
   data.S[0].setZero();

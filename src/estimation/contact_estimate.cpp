@@ -4,25 +4,32 @@ namespace extwrench {
 
 std::string_view to_string(SensorType s) noexcept {
   switch (s) {
-    case SensorType::kNone: return "none";
-    case SensorType::kForce: return "force";
-    case SensorType::kForceTorque: return "ft";
+    case SensorType::kNone:
+      return "none";
+    case SensorType::kForce:
+      return "force";
+    case SensorType::kForceTorque:
+      return "ft";
   }
   return "unknown";
 }
 
 std::string_view to_string(ContactModel m) noexcept {
   switch (m) {
-    case ContactModel::kPureForce: return "pure_force";
-    case ContactModel::kKnownPoint: return "known_point";
+    case ContactModel::kPureForce:
+      return "pure_force";
+    case ContactModel::kKnownPoint:
+      return "known_point";
   }
   return "unknown";
 }
 
 std::string_view to_string(AccelerationRoute a) noexcept {
   switch (a) {
-    case AccelerationRoute::kResidual: return "residual";
-    case AccelerationRoute::kDifferentiation: return "differentiation";
+    case AccelerationRoute::kResidual:
+      return "residual";
+    case AccelerationRoute::kDifferentiation:
+      return "differentiation";
   }
   return "unknown";
 }
@@ -32,13 +39,20 @@ std::string describe_flags(std::uint32_t flags) {
     std::uint32_t bit;
     const char* name;
   } kNames[] = {
-      {EstimateFlag::kContact, "contact"},          {EstimateFlag::kPending, "pending"},
-      {EstimateFlag::kForce, "force"},              {EstimateFlag::kMoment, "moment"},
-      {EstimateFlag::kLineOfAction, "line"},        {EstimateFlag::kSurfacePoint, "surface_point"},
-      {EstimateFlag::kSurfaceMissed, "surface_missed"}, {EstimateFlag::kKnownPoint, "known_point"},
-      {EstimateFlag::kNoGeometry, "no_geometry"},   {EstimateFlag::kIllConditioned, "ill_conditioned"},
-      {EstimateFlag::kUnobservable, "unobservable"}, {EstimateFlag::kDisagreement, "disagreement"},
-      {EstimateFlag::kBaseOnly, "base_only"},       {EstimateFlag::kTaring, "taring"},
+      {EstimateFlag::kContact, "contact"},
+      {EstimateFlag::kPending, "pending"},
+      {EstimateFlag::kForce, "force"},
+      {EstimateFlag::kMoment, "moment"},
+      {EstimateFlag::kLineOfAction, "line"},
+      {EstimateFlag::kSurfacePoint, "surface_point"},
+      {EstimateFlag::kSurfaceMissed, "surface_missed"},
+      {EstimateFlag::kKnownPoint, "known_point"},
+      {EstimateFlag::kNoGeometry, "no_geometry"},
+      {EstimateFlag::kIllConditioned, "ill_conditioned"},
+      {EstimateFlag::kUnobservable, "unobservable"},
+      {EstimateFlag::kDisagreement, "disagreement"},
+      {EstimateFlag::kBaseOnly, "base_only"},
+      {EstimateFlag::kTaring, "taring"},
       {EstimateFlag::kLinkMismatch, "link_mismatch"},
   };
   std::string out;

@@ -1,13 +1,12 @@
 #include "extwrench/estimation/contact_estimator.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <string>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/crba.hpp"
@@ -26,8 +25,8 @@ constexpr double kTimeSlack = 1e-9;  // [s]
 constexpr double kSettleTimeConstants = 5.0;
 
 struct DlsInfo {
-  bool rank_ok = false;   ///< σ_min > rank_tolerance · σ_max
-  bool damped = false;    ///< σ_min < σ_max / max_condition: damping active
+  bool rank_ok = false;  ///< σ_min > rank_tolerance · σ_max
+  bool damped = false;   ///< σ_min < σ_max / max_condition: damping active
   double condition = kNaN;
 };
 
@@ -77,8 +76,8 @@ constexpr int kSpectrumIterations = 4;
 
 /// Solves Jᵀ x = b in the damped least-squares sense, J: R×n of which only the first `cols`
 /// columns (the joints up to the contact link) can be non-zero. x = (J Jᵀ + μ² I)⁻¹ J b with
-/// the damping law of the header, by an LDLᵀ factorisation (fixed size: no allocation). σ_min and σ_max
-/// come from the extreme eigenvalues of A = J Jᵀ: J moves little between samples, so a few
+/// the damping law of the header, by an LDLᵀ factorisation (fixed size: no allocation). σ_min and
+/// σ_max come from the extreme eigenvalues of A = J Jᵀ: J moves little between samples, so a few
 /// power (λ_max) and inverse (λ_min, with the Cholesky factor) iterations from the previous
 /// sample's eigenvectors (`guess`, `guess_size` = R when valid) usually suffice; otherwise (first
 /// sample, a change of link, fast motion near a singularity) a full symmetric eigensolver gives
@@ -171,7 +170,8 @@ const Model& checked_model(const Model& model, const EstimatorOptions& o) {
       throw Error(where + ": contact.link: body index " + std::to_string(o.contact.link) +
                   " is not in [0, " + std::to_string(model.num_bodies() - 1) + "]");
     }
-    if (!o.contact.point.allFinite()) throw Error(where + ": contact.point: expected finite values");
+    if (!o.contact.point.allFinite())
+      throw Error(where + ": contact.point: expected finite values");
   }
   const Pose& X = o.sensor.pose;
   if (!X.translation.allFinite() || !X.rotation.allFinite() ||
@@ -204,7 +204,8 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
       detector_(options_.detection, observer_.nq()),
       n_(observer_.nq()) {
   const Model& m = observer_.model();
-  if (geometry_.body_shapes.empty()) geometry_.body_shapes.resize(static_cast<std::size_t>(m.num_bodies()));
+  if (geometry_.body_shapes.empty())
+    geometry_.body_shapes.resize(static_cast<std::size_t>(m.num_bodies()));
   if (static_cast<int>(geometry_.body_shapes.size()) != m.num_bodies()) {
     throw Error("estimator for robot '" + m.name + "': the collision geometry has " +
                 std::to_string(geometry_.body_shapes.size()) + " bodies, the model " +
@@ -213,7 +214,9 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   if (options_.friction) observer_.set_friction(*options_.friction);
   if (options_.payload) {
     const Status s = observer_.set_payload(options_.payload->body, options_.payload->inertia);
-    if (!s.ok()) throw Error("estimator for robot '" + m.name + "': payload: non-finite or negative mass properties");
+    if (!s.ok())
+      throw Error("estimator for robot '" + m.name +
+                  "': payload: non-finite or negative mass properties");
   }
   const double slowest = options_.acceleration == AccelerationRoute::kResidual
                              ? 1.0 / observer_.gains().minCoeff()
@@ -294,7 +297,8 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
                                 const Eigen::Ref<const VectorX>& dq,
                                 const Eigen::Ref<const VectorX>& tau) noexcept {
   if (options_.sensor.type != SensorType::kNone) {
-    fail(t, {StatusCode::kWrongSize, Channel::kBaseWrench, 0});  // a sensor is configured: reading needed
+    fail(t, {StatusCode::kWrongSize, Channel::kBaseWrench,
+             0});  // a sensor is configured: reading needed
     return out_.status;
   }
   return update(t, q, dq, tau, Vector6::Zero());
@@ -442,8 +446,8 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
   const SensorType sensor = options_.sensor.type;
   const bool has_sensor = sensor != SensorType::kNone && status.ok();
   const Pose& X_WS = options_.sensor.pose;
-  Vector3 F = Vector3::Constant(kNaN);       // F̂_ext
-  Vector3 dn_s = Vector3::Constant(kNaN);    // n_m − ñ_g, about O_s (F/T)
+  Vector3 F = Vector3::Constant(kNaN);     // F̂_ext
+  Vector3 dn_s = Vector3::Constant(kNaN);  // n_m − ñ_g, about O_s (F/T)
   bool taring = false;
   if (has_sensor) {
     // What the robot would discharge with this motion and no contact (f̃_g, ñ_g), world, about O_s.
@@ -518,8 +522,8 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
       b_ = tau_ext_;
       b_.noalias() -= J_.topRows<3>().transpose() * F;
       Vector3 x;
-      const DlsInfo info = damped_solve<3>(J_.bottomRows<3>(), link, b_, options_.solver, x, spectrum_min_,
-                                           spectrum_max_, spectrum_size_);
+      const DlsInfo info = damped_solve<3>(J_.bottomRows<3>(), link, b_, options_.solver, x,
+                                           spectrum_min_, spectrum_max_, spectrum_size_);
       out_.condition_number = info.condition;
       if (info.rank_ok) {
         M_bar = x;

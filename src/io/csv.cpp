@@ -24,7 +24,7 @@ namespace {
 constexpr std::size_t kReadChunk = std::size_t{1} << 18;   // 256 KiB per read()
 constexpr std::size_t kWriteChunk = std::size_t{1} << 20;  // flush the writer every 1 MiB
 constexpr std::size_t kMaxNumberChars = 32;  // the shortest form of a double: at most 24 chars
-constexpr std::size_t kShownCellChars = 40;                // longer cells are cut in messages
+constexpr std::size_t kShownCellChars = 40;  // longer cells are cut in messages
 
 bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
@@ -210,8 +210,9 @@ void CsvReader::split_quoted_line() {
       const std::size_t comma = std::min(line.find(',', i), line.size());
       const std::string_view cell = trim(line.substr(i, comma - i));
       if (cell.find('"') != std::string_view::npos) {
-        throw Error(where() + "column " + std::to_string(cells_.size() + 1) +
-                    ": a quote inside an unquoted cell (quote the whole cell and double the quote)");
+        throw Error(
+            where() + "column " + std::to_string(cells_.size() + 1) +
+            ": a quote inside an unquoted cell (quote the whole cell and double the quote)");
       }
       cells_.push_back(cell);
       i = comma;
@@ -238,7 +239,8 @@ void CsvReader::read_header() {
     const auto [it, inserted] = column_index_.emplace(header_[k], static_cast<int>(k));
     if (!inserted) {
       throw Error(where() + "column " + std::to_string(k + 1) + " '" + header_[k] +
-                  "' appears twice in the header (also column " + std::to_string(it->second + 1) + ")");
+                  "' appears twice in the header (also column " + std::to_string(it->second + 1) +
+                  ")");
     }
   }
   cells_.clear();
@@ -317,7 +319,8 @@ double CsvReader::parse(int column, bool allow_missing) const {
 
 double CsvReader::number(int column) const {
   double value = 0.0;
-  if (static_cast<std::size_t>(column) < cells_.size() && plain_number(cells_[static_cast<std::size_t>(column)], value)) {
+  if (static_cast<std::size_t>(column) < cells_.size() &&
+      plain_number(cells_[static_cast<std::size_t>(column)], value)) {
     return value;
   }
   return parse(column, false);  // the rest, with messages that name what is wrong
@@ -325,7 +328,8 @@ double CsvReader::number(int column) const {
 
 double CsvReader::number_or_nan(int column) const {
   double value = 0.0;
-  if (static_cast<std::size_t>(column) < cells_.size() && plain_number(cells_[static_cast<std::size_t>(column)], value)) {
+  if (static_cast<std::size_t>(column) < cells_.size() &&
+      plain_number(cells_[static_cast<std::size_t>(column)], value)) {
     return value;
   }
   return parse(column, true);

@@ -1,12 +1,12 @@
 // DH table in YAML (yaml-cpp) -> ModelBuilder specs + collision shapes. The format, with every
 // key and unit, is in docs/model.md. Strict: unknown keys, non-numbers, missing required keys
 // are errors naming file:line and the key.
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <map>
 #include <numbers>
 #include <set>
-
-#include <yaml-cpp/yaml.h>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/robot_loader.hpp"
@@ -68,7 +68,8 @@ std::optional<double> parse_angle(std::string_view text) {
 
 class DhParser {
  public:
-  DhParser(std::string file, fs::path base_dir) : file_(std::move(file)), base_dir_(std::move(base_dir)) {}
+  DhParser(std::string file, fs::path base_dir)
+      : file_(std::move(file)), base_dir_(std::move(base_dir)) {}
 
   RobotDescription parse(const YAML::Node& root, const LoadOptions& options) {
     expect_map(root, "(document)", root);
@@ -81,7 +82,8 @@ class DhParser {
     if (convention == "modified") {
       modified = true;
     } else if (convention != "standard") {
-      fail(root["convention"], "convention", "expected 'standard' or 'modified', got '" + convention + "'");
+      fail(root["convention"], "convention",
+           "expected 'standard' or 'modified', got '" + convention + "'");
     }
     if (root["gravity"]) builder.set_gravity(vec3(root, "gravity", "", std::nullopt));
     if (options.gravity) builder.set_gravity(*options.gravity);
@@ -98,15 +100,18 @@ class DhParser {
 
     if (!root["joints"]) fail(root, "joints", "missing (required)");
     const YAML::Node joints = root["joints"];
-    if (!joints.IsSequence() || joints.size() == 0) fail(joints, "joints", "expected a non-empty list of joints");
-    // P = X_{body, DH frame} of the previous link: identity unless it is a standard-DH link with a != 0.
+    if (!joints.IsSequence() || joints.size() == 0)
+      fail(joints, "joints", "expected a non-empty list of joints");
+    // P = X_{body, DH frame} of the previous link: identity unless it is a standard-DH link with a
+    // != 0.
     Pose P_prev = Pose::identity();
     for (std::size_t i = 0; i < joints.size(); ++i) {
       const YAML::Node j = joints[i];
       const std::string path = "joints[" + std::to_string(i) + "]";
       expect_map(j, path, j);
-      check_keys(j, path, {"name", "type", "a", "alpha", "d", "theta", "lower", "upper", "velocity", "effort", "damping",
-                           "friction", "link"});
+      check_keys(j, path,
+                 {"name", "type", "a", "alpha", "d", "theta", "lower", "upper", "velocity",
+                  "effort", "damping", "friction", "link"});
       JointSpec js;
       js.source = at(j);
       js.name = required_scalar(j, "name", path);
@@ -126,20 +131,24 @@ class DhParser {
       js.lower = number(j, "lower", path, -std::numeric_limits<double>::infinity(), revolute);
       js.upper = number(j, "upper", path, std::numeric_limits<double>::infinity(), revolute);
       if (js.lower > js.upper) fail(j["lower"], path + ".lower", "lower > upper");
-      js.velocity_limit = number(j, "velocity", path, std::numeric_limits<double>::infinity(), false);
+      js.velocity_limit =
+          number(j, "velocity", path, std::numeric_limits<double>::infinity(), false);
       js.effort_limit = number(j, "effort", path, std::numeric_limits<double>::infinity(), false);
       js.damping = number(j, "damping", path, 0.0, false);
       js.friction = number(j, "friction", path, 0.0, false);
 
-      // The body frame is the joint frame after the motion (X_{parent,i}(q) = placement Rot(axis, q)).
+      // The body frame is the joint frame after the motion (X_{parent,i}(q) = placement Rot(axis,
+      // q)).
       Pose P;  // X_{body i, DH frame i}
       if (modified) {
-        // Craig: frame_i = frame_{i-1} Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta + q) Tz(d): body = DH frame.
+        // Craig: frame_i = frame_{i-1} Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta + q) Tz(d): body = DH
+        // frame.
         js.origin = P_prev * rot_x(alpha) * trans(a, 0, 0) * rot_z(theta) * trans(0, 0, d);
         js.axis = Vector3::UnitZ();
       } else if (a == 0.0) {
-        // Standard, a = 0: frame_i = frame_{i-1} Rz(theta + q) Tz(d) Rx(alpha) = [Rz(theta) Tz(d) Rx(alpha)] Rot(axis, q)
-        // with axis = Rx(alpha)^T z = (0, sin alpha, cos alpha): the body frame is the DH frame.
+        // Standard, a = 0: frame_i = frame_{i-1} Rz(theta + q) Tz(d) Rx(alpha) = [Rz(theta) Tz(d)
+        // Rx(alpha)] Rot(axis, q) with axis = Rx(alpha)^T z = (0, sin alpha, cos alpha): the body
+        // frame is the DH frame.
         js.origin = P_prev * rot_z(theta) * trans(0, 0, d) * rot_x(alpha);
         js.axis = Vector3(0.0, std::sin(alpha), std::cos(alpha));
       } else {
@@ -163,11 +172,13 @@ class DhParser {
       dh_placement_[js.child] = P;
       const bool separate_dh_frame = !modified && a != 0.0;
       if (link["dh_frame"] && !separate_dh_frame) {
-        fail(link["dh_frame"], lpath + ".dh_frame", "only allowed for standard DH with a != 0 (otherwise the link frame is the DH frame)");
+        fail(link["dh_frame"], lpath + ".dh_frame",
+             "only allowed for standard DH with a != 0 (otherwise the link frame is the DH frame)");
       }
       if (separate_dh_frame) {
         FrameSpec f;
-        f.name = link["dh_frame"] ? scalar(link["dh_frame"], lpath + ".dh_frame") : js.child + "_dh";
+        f.name =
+            link["dh_frame"] ? scalar(link["dh_frame"], lpath + ".dh_frame") : js.child + "_dh";
         f.link = js.child;
         f.placement = P;
         f.source = at(link);
@@ -189,7 +200,8 @@ class DhParser {
         fs.link = required_scalar(f, "link", path);
         fs.source = at(f);
         const auto dh = dh_placement_.find(fs.link);
-        if (dh == dh_placement_.end()) fail(f["link"], path + ".link", "no link named '" + fs.link + "'");
+        if (dh == dh_placement_.end())
+          fail(f["link"], path + ".link", "no link named '" + fs.link + "'");
         // Given in the link's DH frame.
         fs.placement = dh->second * pose(f, path);
         builder.add_frame(fs);
@@ -210,13 +222,15 @@ class DhParser {
   static std::string join(const std::string& path, const std::string& key) {
     return path.empty() ? key : path + "." + key;
   }
-  [[noreturn]] void fail(const YAML::Node& n, const std::string& key, const std::string& what) const {
+  [[noreturn]] void fail(const YAML::Node& n, const std::string& key,
+                         const std::string& what) const {
     throw Error(at(n) + ": key '" + key + "': " + what);
   }
   void expect_map(const YAML::Node& n, const std::string& path, const YAML::Node& where) const {
     if (!n.IsMap()) fail(where, path, "expected a mapping");
   }
-  void check_keys(const YAML::Node& map, const std::string& path, std::initializer_list<const char*> allowed) const {
+  void check_keys(const YAML::Node& map, const std::string& path,
+                  std::initializer_list<const char*> allowed) const {
     const std::set<std::string> ok(allowed.begin(), allowed.end());
     for (const auto& kv : map) {
       const std::string k = kv.first.as<std::string>();
@@ -231,7 +245,8 @@ class DhParser {
     if (!n.IsScalar()) fail(n, path, "expected a single value");
     return n.Scalar();
   }
-  std::string required_scalar(const YAML::Node& map, const char* key, const std::string& path) const {
+  std::string required_scalar(const YAML::Node& map, const char* key,
+                              const std::string& path) const {
     if (!map[key]) fail(map, join(path, key), "missing (required)");
     const std::string s = scalar(map[key], join(path, key));
     if (s.empty()) fail(map[key], join(path, key), "must not be empty");
@@ -240,11 +255,14 @@ class DhParser {
   double to_number(const YAML::Node& n, const std::string& path, bool angle) const {
     const std::string s = scalar(n, path);
     const auto v = angle ? parse_angle(s) : io_detail::parse_double(s);
-    if (!v) fail(n, path, std::string("expected a number") + (angle ? " (or pi expression)" : "") + ", got '" + s + "'");
+    if (!v)
+      fail(n, path,
+           std::string("expected a number") + (angle ? " (or pi expression)" : "") + ", got '" + s +
+               "'");
     return *v;
   }
-  double number(const YAML::Node& map, const char* key, const std::string& path, std::optional<double> fallback,
-                bool angle) const {
+  double number(const YAML::Node& map, const char* key, const std::string& path,
+                std::optional<double> fallback, bool angle) const {
     const YAML::Node n = map[key];
     if (!n) {
       if (fallback) return *fallback;
@@ -252,8 +270,8 @@ class DhParser {
     }
     return to_number(n, join(path, key), angle);
   }
-  Vector3 vec3(const YAML::Node& map, const char* key, const std::string& path, std::optional<Vector3> fallback,
-               bool angle = false) const {
+  Vector3 vec3(const YAML::Node& map, const char* key, const std::string& path,
+               std::optional<Vector3> fallback, bool angle = false) const {
     const YAML::Node n = map[key];
     const std::string p = join(path, key);
     if (!n) {
@@ -262,27 +280,31 @@ class DhParser {
     }
     if (!n.IsSequence() || n.size() != 3) fail(n, p, "expected a list of 3 numbers");
     Vector3 v;
-    for (std::size_t i = 0; i < 3; ++i) v[static_cast<Eigen::Index>(i)] = to_number(n[i], p + "[" + std::to_string(i) + "]", angle);
+    for (std::size_t i = 0; i < 3; ++i)
+      v[static_cast<Eigen::Index>(i)] = to_number(n[i], p + "[" + std::to_string(i) + "]", angle);
     return v;
   }
   Pose pose(const YAML::Node& map, const std::string& path) const {
-    return Pose::from_xyz_rpy(vec3(map, "xyz", path, Vector3::Zero()), vec3(map, "rpy", path, Vector3::Zero(), true));
+    return Pose::from_xyz_rpy(vec3(map, "xyz", path, Vector3::Zero()),
+                              vec3(map, "rpy", path, Vector3::Zero(), true));
   }
   // [ixx, ixy, ixz, iyy, iyz, izz] or a 3x3 list of rows.
   Matrix3 inertia(const YAML::Node& n, const std::string& p) const {
     Matrix3 I;
     if (n.IsSequence() && n.size() == 6) {
       double v[6];
-      for (std::size_t i = 0; i < 6; ++i) v[i] = to_number(n[i], p + "[" + std::to_string(i) + "]", false);
+      for (std::size_t i = 0; i < 6; ++i)
+        v[i] = to_number(n[i], p + "[" + std::to_string(i) + "]", false);
       I << v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5];
       return I;
     }
     if (n.IsSequence() && n.size() == 3) {
       for (std::size_t r = 0; r < 3; ++r) {
-        if (!n[r].IsSequence() || n[r].size() != 3) fail(n[r], p + "[" + std::to_string(r) + "]", "expected a row of 3 numbers");
+        if (!n[r].IsSequence() || n[r].size() != 3)
+          fail(n[r], p + "[" + std::to_string(r) + "]", "expected a row of 3 numbers");
         for (std::size_t c = 0; c < 3; ++c) {
-          I(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) =
-              to_number(n[r][c], p + "[" + std::to_string(r) + "][" + std::to_string(c) + "]", false);
+          I(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = to_number(
+              n[r][c], p + "[" + std::to_string(r) + "][" + std::to_string(c) + "]", false);
         }
       }
       return I;
@@ -291,25 +313,30 @@ class DhParser {
   }
 
   // Mass properties given in the DH frame (X_{body, DH} = P), returned in the body frame.
-  LinkSpec link_spec(const YAML::Node& map, const std::string& path, const std::string& name, const Pose& P) const {
+  LinkSpec link_spec(const YAML::Node& map, const std::string& path, const std::string& name,
+                     const Pose& P) const {
     LinkSpec l;
     l.name = name;
     l.source = at(map);
     Inertia in;
     in.mass = number(map, "mass", path, std::nullopt, false);
-    if (in.mass < 0.0) fail(map["mass"], join(path, "mass"), "must not be negative, got '" + map["mass"].Scalar() + "'");
+    if (in.mass < 0.0)
+      fail(map["mass"], join(path, "mass"),
+           "must not be negative, got '" + map["mass"].Scalar() + "'");
     in.com = vec3(map, "com", path, Vector3::Zero());
     if (map["inertia"]) {
       in.inertia_com = inertia(map["inertia"], path + ".inertia");
       l.inertia_source = at(map["inertia"]) + ": key '" + path + ".inertia'";
     }
     // Check before the rotation hides an asymmetric or non-physical input.
-    validate_inertia(in, (l.inertia_source.empty() ? l.source : l.inertia_source) + ": link '" + name + "'");
+    validate_inertia(
+        in, (l.inertia_source.empty() ? l.source : l.inertia_source) + ": link '" + name + "'");
     l.inertia = in.transformed(P);
     return l;
   }
 
-  void parse_collisions(const YAML::Node& map, const std::string& path, const std::string& link, const Pose& P) {
+  void parse_collisions(const YAML::Node& map, const std::string& path, const std::string& link,
+                        const Pose& P) {
     const YAML::Node list = map["collision"];
     if (!list) return;
     if (!list.IsSequence()) fail(list, path + ".collision", "expected a list of shapes");
@@ -341,14 +368,16 @@ class DhParser {
         s.type = type == "cylinder" ? ShapeType::kCylinder : ShapeType::kCapsule;
         s.radius = positive("radius");
         s.length = number(c, "length", p, std::nullopt, false);
-        if (s.length < 0.0 || (s.type == ShapeType::kCylinder && s.length == 0.0)) fail(c["length"], p + ".length", "must be positive");
+        if (s.length < 0.0 || (s.type == ShapeType::kCylinder && s.length == 0.0))
+          fail(c["length"], p + ".length", "must be positive");
       } else if (type == "mesh") {
         check_keys(c, p, {"type", "filename", "scale", "xyz", "rpy"});
         s.type = ShapeType::kMesh;
         spec.mesh_uri = required_scalar(c, "filename", p);
         s.scale = vec3(c, "scale", p, Vector3::Ones());
       } else {
-        fail(c["type"], p + ".type", "unknown shape '" + type + "' (expected sphere, box, cylinder, capsule or mesh)");
+        fail(c["type"], p + ".type",
+             "unknown shape '" + type + "' (expected sphere, box, cylinder, capsule or mesh)");
       }
       // Declared in the DH frame: X_{body, shape} = P X_{DH, shape}.
       s.placement = P * pose(c, p);
@@ -371,7 +400,8 @@ RobotDescription load_dh_yaml(const fs::path& path, const LoadOptions& options) 
   } catch (const YAML::BadFile&) {
     throw Error(path.string() + ": cannot open file");
   } catch (const YAML::ParserException& e) {
-    throw Error(path.string() + ":" + std::to_string(e.mark.line + 1) + ": not valid YAML: " + e.msg);
+    throw Error(path.string() + ":" + std::to_string(e.mark.line + 1) +
+                ": not valid YAML: " + e.msg);
   }
   DhParser parser(path.string(), path.parent_path().empty() ? fs::path(".") : path.parent_path());
   RobotDescription r;

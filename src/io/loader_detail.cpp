@@ -14,7 +14,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+bool is_space(char c) {
+  return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
+}
 
 std::string_view trim(std::string_view s) {
   while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
@@ -79,13 +81,15 @@ std::optional<fs::path> resolve_mesh_path(const std::string& uri, const fs::path
     }
     for (const fs::path& dir : dirs) {
       // A search directory contains packages; it may also be the package itself (ROS allows both).
-      for (const fs::path& candidate : {dir / package / relative, dir.filename() == package ? dir / relative : fs::path()}) {
+      for (const fs::path& candidate :
+           {dir / package / relative, dir.filename() == package ? dir / relative : fs::path()}) {
         if (!candidate.empty() && exists_file(candidate)) return candidate;
       }
     }
     if (why) {
       *why = "cannot resolve '" + uri + "': no file '" + relative + "' in a package '" + package +
-             "' under LoadOptions::package_path" + (options.use_ros_package_path ? " or ROS_PACKAGE_PATH" : "") + " (" +
+             "' under LoadOptions::package_path" +
+             (options.use_ros_package_path ? " or ROS_PACKAGE_PATH" : "") + " (" +
              std::to_string(dirs.size()) + " directories searched)";
     }
     return std::nullopt;
@@ -94,7 +98,8 @@ std::optional<fs::path> resolve_mesh_path(const std::string& uri, const fs::path
   if (u.substr(0, kFile.size()) == kFile) {
     p = fs::path(std::string(u.substr(kFile.size())));
   } else if (const auto scheme = u.find("://"); scheme != std::string_view::npos) {
-    if (why) *why = "unsupported URI scheme in '" + uri + "' (expected package://, file:// or a path)";
+    if (why)
+      *why = "unsupported URI scheme in '" + uri + "' (expected package://, file:// or a path)";
     return std::nullopt;
   } else {
     p = fs::path(uri);
@@ -107,8 +112,8 @@ std::optional<fs::path> resolve_mesh_path(const std::string& uri, const fs::path
   return p;
 }
 
-GeometryModel build_geometry(const Model& model, const std::vector<ShapeSpec>& shapes, const fs::path& base_dir,
-                             const LoadOptions& options) {
+GeometryModel build_geometry(const Model& model, const std::vector<ShapeSpec>& shapes,
+                             const fs::path& base_dir, const LoadOptions& options) {
   GeometryModel geometry;
   geometry.body_shapes.resize(static_cast<std::size_t>(model.num_bodies()));
   for (const ShapeSpec& spec : shapes) {
@@ -139,7 +144,8 @@ GeometryModel build_geometry(const Model& model, const std::vector<ShapeSpec>& s
         shape.mesh = std::move(mesh);
       }
     }
-    geometry.body_shapes[static_cast<std::size_t>(shape.body)].push_back(static_cast<int>(geometry.shapes.size()));
+    geometry.body_shapes[static_cast<std::size_t>(shape.body)].push_back(
+        static_cast<int>(geometry.shapes.size()));
     geometry.shapes.push_back(std::move(shape));
   }
   return geometry;

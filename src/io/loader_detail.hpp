@@ -25,16 +25,18 @@ std::vector<std::string_view> split_ws(std::string_view text);
 /// body not yet known. `mesh_uri` is the file name as written (kMesh only).
 struct ShapeSpec {
   CollisionShape shape;
-  std::string frame;      ///< link (or frame) the shape is declared in
+  std::string frame;  ///< link (or frame) the shape is declared in
   std::string mesh_uri;
-  std::string source;     ///< "file:line: <mesh> of link 'x'", prefix of error messages
+  std::string source;  ///< "file:line: <mesh> of link 'x'", prefix of error messages
 };
 
 /// Resolves a mesh file name: `package://NAME/rest` through options.package_path then
 /// ROS_PACKAGE_PATH, `file:///abs`, or a path relative to `base_dir`. Returns nothing when the
 /// file cannot be found; `why` then says why.
-std::optional<std::filesystem::path> resolve_mesh_path(const std::string& uri, const std::filesystem::path& base_dir,
-                                                       const LoadOptions& options, std::string* why);
+std::optional<std::filesystem::path> resolve_mesh_path(const std::string& uri,
+                                                       const std::filesystem::path& base_dir,
+                                                       const LoadOptions& options,
+                                                       std::string* why);
 
 /// Places every shape on its body (X_{body, shape} = X_{body, frame} * X_{frame, shape}) and,
 /// when options.load_meshes, loads the meshes. Throws extwrench::Error prefixed by the shape's

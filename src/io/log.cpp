@@ -51,8 +51,9 @@ LogReader::LogReader(const std::filesystem::path& path, const Model& model)
     const auto c = csv_.find_column(name);
     if (!c) {
       throw Error(csv_.name() + ":1: missing column '" + name + "' (robot '" + model.name +
-                  "' has " + std::to_string(n) + " joints: the log needs t, q1..q" + std::to_string(n) +
-                  ", tau1..tau" + std::to_string(n) + "; see docs/log_format.md)");
+                  "' has " + std::to_string(n) + " joints: the log needs t, q1..q" +
+                  std::to_string(n) + ", tau1..tau" + std::to_string(n) +
+                  "; see docs/log_format.md)");
     }
     known.insert(*c);
     return *c;
@@ -65,8 +66,9 @@ LogReader::LogReader(const std::filesystem::path& path, const Model& model)
     if (found != static_cast<int>(names.size())) {
       for (const auto& name : names) {
         if (!csv_.find_column(name)) {
-          throw Error(csv_.name() + ":1: missing column '" + name + "' (the log has " + names.front() +
-                      " but not all of " + names.front() + ".." + names.back() + ")");
+          throw Error(csv_.name() + ":1: missing column '" + name + "' (the log has " +
+                      names.front() + " but not all of " + names.front() + ".." + names.back() +
+                      ")");
         }
       }
     }
@@ -80,7 +82,9 @@ LogReader::LogReader(const std::filesystem::path& path, const Model& model)
   layout_.force = group({kFs[0], kFs[1], kFs[2]}, col_fs_);
   layout_.moment = group({kMs[0], kMs[1], kMs[2]}, col_ms_);
   if (layout_.moment && !layout_.force) {
-    throw Error(csv_.name() + ":1: columns ms_x..ms_z need fs_x..fs_z too (a moment-only base sensor is not supported)");
+    throw Error(
+        csv_.name() +
+        ":1: columns ms_x..ms_z need fs_x..fs_z too (a moment-only base sensor is not supported)");
   }
   const bool f = group({kTrueF[0], kTrueF[1], kTrueF[2]}, col_f_);
   const bool m = group({kTrueM[0], kTrueM[1], kTrueM[2]}, col_m_);
@@ -101,8 +105,10 @@ LogReader::LogReader(const std::filesystem::path& path, const Model& model)
 }
 
 void LogReader::read_vector(const std::vector<int>& columns, VectorX& v) const {
-  if (v.size() != static_cast<Eigen::Index>(columns.size())) v.resize(static_cast<Eigen::Index>(columns.size()));
-  for (std::size_t i = 0; i < columns.size(); ++i) v[static_cast<Eigen::Index>(i)] = csv_.number(columns[i]);
+  if (v.size() != static_cast<Eigen::Index>(columns.size()))
+    v.resize(static_cast<Eigen::Index>(columns.size()));
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    v[static_cast<Eigen::Index>(i)] = csv_.number(columns[i]);
 }
 
 bool LogReader::read_row(sim::Sample& s) {
@@ -110,15 +116,18 @@ bool LogReader::read_row(sim::Sample& s) {
   s.t = csv_.number(col_t_);
   if (have_prev_ && !(s.t > prev_t_)) {
     throw Error(csv_.where(col_t_) + "time must increase (" + std::string(csv_.cell(col_t_)) +
-                " after " + CsvWriter::format(prev_t_) + " on line " + std::to_string(prev_line_) + ")");
+                " after " + CsvWriter::format(prev_t_) + " on line " + std::to_string(prev_line_) +
+                ")");
   }
   read_vector(col_q_, s.q);
   read_vector(col_tau_, s.tau);
   if (layout_.velocity) read_vector(col_dq_, s.dq);
   s.has_force = layout_.force;
   s.has_moment = layout_.moment;
-  for (int k = 0; k < 3 && layout_.force; ++k) s.sensor[k] = csv_.number(col_fs_[static_cast<std::size_t>(k)]);
-  for (int k = 0; k < 3; ++k) s.sensor[3 + k] = layout_.moment ? csv_.number(col_ms_[static_cast<std::size_t>(k)]) : 0.0;
+  for (int k = 0; k < 3 && layout_.force; ++k)
+    s.sensor[k] = csv_.number(col_fs_[static_cast<std::size_t>(k)]);
+  for (int k = 0; k < 3; ++k)
+    s.sensor[3 + k] = layout_.moment ? csv_.number(col_ms_[static_cast<std::size_t>(k)]) : 0.0;
   if (!layout_.force) s.sensor.head<3>().setZero();
   s.has_truth = layout_.truth;
   s.has_true_tau_ext = layout_.true_tau_ext;
@@ -136,7 +145,8 @@ bool LogReader::read_row(sim::Sample& s) {
         const std::string name(link.substr(start, end - start));
         const auto body = model_->find_body(name);
         if (!body) {
-          throw Error(csv_.where(col_link_) + "'" + name + "' is not a link of robot '" + model_->name + "'");
+          throw Error(csv_.where(col_link_) + "'" + name + "' is not a link of robot '" +
+                      model_->name + "'");
         }
         if (last_body_ < 0) last_body_ = *body;
         ++last_contacts_;
@@ -150,10 +160,11 @@ bool LogReader::read_row(sim::Sample& s) {
     auto vec3 = [&](const std::vector<int>& cols, Vector3& v) {
       for (int k = 0; k < 3; ++k) {
         const double x = cols.empty() ? 0.0 : csv_.number_or_nan(cols[static_cast<std::size_t>(k)]);
-        if (std::isinf(x)) throw Error(csv_.where(cols[static_cast<std::size_t>(k)]) + "expected a finite number");
+        if (std::isinf(x))
+          throw Error(csv_.where(cols[static_cast<std::size_t>(k)]) + "expected a finite number");
         if (std::isnan(x) && tr.body >= 0) {
-          throw Error(csv_.where(cols[static_cast<std::size_t>(k)]) + "expected a number (true_link is '" +
-                      last_link_ + "'), got an empty cell");
+          throw Error(csv_.where(cols[static_cast<std::size_t>(k)]) +
+                      "expected a number (true_link is '" + last_link_ + "'), got an empty cell");
         }
         v[k] = std::isnan(x) ? 0.0 : x;
       }
@@ -209,10 +220,13 @@ LogWriter::LogWriter(const std::filesystem::path& path, const LogLayout& layout)
 void LogWriter::write(const sim::Sample& s) {
   csv_.add(s.t);
   for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.q[i]);
-  if (layout_.velocity) for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.dq[i]);
+  if (layout_.velocity)
+    for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.dq[i]);
   for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.tau[i]);
-  if (layout_.force) for (int k = 0; k < 3; ++k) csv_.add(s.sensor[k]);
-  if (layout_.force && layout_.moment) for (int k = 3; k < 6; ++k) csv_.add(s.sensor[k]);
+  if (layout_.force)
+    for (int k = 0; k < 3; ++k) csv_.add(s.sensor[k]);
+  if (layout_.force && layout_.moment)
+    for (int k = 3; k < 6; ++k) csv_.add(s.sensor[k]);
   if (layout_.truth) {
     csv_.add(std::string_view(s.truth.link));
     for (int k = 0; k < 3; ++k) csv_.add(s.truth.force[k]);
@@ -226,14 +240,15 @@ void LogWriter::write(const sim::Sample& s) {
       }
     }
   }
-  if (layout_.true_tau_ext) for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.truth.tau_ext[i]);
+  if (layout_.true_tau_ext)
+    for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.truth.tau_ext[i]);
   csv_.end_row();
 }
 
 namespace {
 std::vector<std::string> estimates_columns(int n) {
-  std::vector<std::string> c{"t",  "contact", "link", "fx", "fy", "fz", "mx", "my", "mz", "px",
-                             "py", "pz",      "lx",   "ly", "lz", "status", "cond"};
+  std::vector<std::string> c{"t",  "contact", "link", "fx", "fy", "fz", "mx",     "my",  "mz",
+                             "px", "py",      "pz",   "lx", "ly", "lz", "status", "cond"};
   for (const auto& r : numbered("r", n)) c.push_back(r);
   return c;
 }

@@ -13,10 +13,18 @@ std::string str(const std::string& s) {
   std::string out = "\"";
   for (const char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
@@ -92,10 +100,11 @@ std::string metrics_json(const MetricsReport& r) {
   // Detection delay is counted over the whole log (onsets anywhere), the same in every window.
   const sim::Metrics* any = r.windows.empty() ? nullptr : &r.windows.front().metrics;
   o += "  \"detection_delay\": {\"window\": \"whole log\", \"onsets\": " +
-       std::to_string(any ? any->onsets : 0) + ", \"detected\": " +
-       std::to_string(any ? any->onsets_detected : 0) + ", \"mean\": " +
-       num(any ? any->mean_detection_delay() : std::nan("")) + ", \"max\": " +
-       num(any && any->onsets_detected > 0 ? any->delay_max : std::nan("")) + ", \"unit\": \"s\"}\n";
+       std::to_string(any ? any->onsets : 0) +
+       ", \"detected\": " + std::to_string(any ? any->onsets_detected : 0) +
+       ", \"mean\": " + num(any ? any->mean_detection_delay() : std::nan("")) +
+       ", \"max\": " + num(any && any->onsets_detected > 0 ? any->delay_max : std::nan("")) +
+       ", \"unit\": \"s\"}\n";
   o += "}\n";
   return o;
 }

@@ -1,12 +1,12 @@
 #include "extwrench/io/plot.hpp"
 
+#include <sys/wait.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
-
-#include <sys/wait.h>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/csv.hpp"
@@ -25,7 +25,8 @@ void Decimator::push(const double* values) {
     const int n = rows();
     int kept = 0;
     for (int i = 0; i < n; i += 2, ++kept) {
-      std::copy(row(i), row(i) + width_, data_.begin() + static_cast<std::ptrdiff_t>(kept) * width_);
+      std::copy(row(i), row(i) + width_,
+                data_.begin() + static_cast<std::ptrdiff_t>(kept) * width_);
     }
     data_.resize(static_cast<std::size_t>(kept) * width_);
     stride_ *= 2;
@@ -54,9 +55,7 @@ void Decimator::write(const std::filesystem::path& path) const {
   if (!out) throw Error(path.string() + ": write failed");
 }
 
-bool gnuplot_available() {
-  return std::system("command -v gnuplot > /dev/null 2>&1") == 0;
-}
+bool gnuplot_available() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
 std::string gnuplot_quote(const std::string& text) {
   std::string out = "'";
@@ -69,8 +68,9 @@ std::string gnuplot_quote(const std::string& text) {
 
 void run_gnuplot(const std::filesystem::path& script) {
   if (!gnuplot_available()) {
-    throw Error("gnuplot not found on the PATH: figures need it (Debian: sudo apt-get install "
-                "gnuplot-nox); or pass --no-figures");
+    throw Error(
+        "gnuplot not found on the PATH: figures need it (Debian: sudo apt-get install "
+        "gnuplot-nox); or pass --no-figures");
   }
   const std::filesystem::path dir = script.parent_path().empty() ? "." : script.parent_path();
   const std::string command = "cd " + gnuplot_quote(dir.string()) + " && gnuplot " +
@@ -88,7 +88,8 @@ void run_gnuplot(const std::filesystem::path& script) {
 
 std::string gnuplot_png_preamble(const std::filesystem::path& png, int width, int height) {
   std::ostringstream s;
-  s << "set terminal pngcairo size " << width << "," << height << " enhanced font 'DejaVu Sans,11'\n"
+  s << "set terminal pngcairo size " << width << "," << height
+    << " enhanced font 'DejaVu Sans,11'\n"
     << "set output " << gnuplot_quote(png.filename().string()) << "\n"
     << "set grid\nset key outside right top\nset datafile missing 'NaN'\n";
   return s.str();

@@ -1,5 +1,9 @@
 #include "extwrench/io/replay.hpp"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <Eigen/SVD>
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -14,10 +18,6 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
-
-#include <Eigen/SVD>
-#include <sys/resource.h>
-#include <unistd.h>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -52,10 +52,10 @@ template <class Item>
 class BatchRing {
  public:
   struct Batch {
-    std::vector<Item> items;    // kBatchRows slots, reused: their vectors keep their capacity
-    std::size_t count = 0;      // items in use
-    bool last = false;          // no batch follows (end of input, or the error below)
-    std::exception_ptr error;   // the producer's failure, to rethrow after the items
+    std::vector<Item> items;   // kBatchRows slots, reused: their vectors keep their capacity
+    std::size_t count = 0;     // items in use
+    bool last = false;         // no batch follows (end of input, or the error below)
+    std::exception_ptr error;  // the producer's failure, to rethrow after the items
   };
 
   explicit BatchRing(const Item& prototype) : ring_(kBatches) {
@@ -256,8 +256,19 @@ class Pipeline {
 
 // Columns of the decimated plot buffer.
 enum Col : int {
-  kT = 0, kContact, kF = 2, kFt = 5, kL = 8, kDir = 11, kP = 14, kPt = 17, kCond = 20,
-  kCondTrue, kTrueContact, kErrF, kQ  // q1..qn follow
+  kT = 0,
+  kContact,
+  kF = 2,
+  kFt = 5,
+  kL = 8,
+  kDir = 11,
+  kP = 14,
+  kPt = 17,
+  kCond = 20,
+  kCondTrue,
+  kTrueContact,
+  kErrF,
+  kQ  // q1..qn follow
 };
 
 sim::TruthSample truth_of(const sim::Sample& s) {
@@ -310,13 +321,16 @@ class Progress {
   bool shown_ = false;
 };
 
-std::string title_of(const ReplayOptions& o) { return o.name.empty() ? std::string("estimate") : o.name; }
+std::string title_of(const ReplayOptions& o) {
+  return o.name.empty() ? std::string("estimate") : o.name;
+}
 
 // Text for gnuplot's enhanced mode: '_' and '^' would start sub- and superscripts.
 std::string enhanced(const std::string& text) {
   std::string out;
   for (const char c : text) {
-    if (c == '_' || c == '^' || c == '@' || c == '&' || c == '~' || c == '{' || c == '}') out += '\\';
+    if (c == '_' || c == '^' || c == '@' || c == '&' || c == '~' || c == '{' || c == '}')
+      out += '\\';
     out += c;
   }
   return out;
@@ -353,7 +367,8 @@ void run_gnuplot_scripts(const std::vector<std::filesystem::path>& scripts) {
 }
 
 std::vector<std::filesystem::path> make_figures(const Model& model, const Decimator& dec,
-                                                const ReplayOptions& o, bool truth, const Vector3& p_WS) {
+                                                const ReplayOptions& o, bool truth,
+                                                const Vector3& p_WS) {
   std::vector<std::filesystem::path> pngs;
   std::vector<std::filesystem::path> scripts;  // run together at the end
   const std::filesystem::path dir = o.out_dir;
@@ -366,10 +381,12 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
 
   {  // Fig. 5: joint positions
     std::ostringstream s;
-    s << gnuplot_png_preamble(dir / "joints.png") << "set title " << gnuplot_quote("Joint positions — " + enhanced(title_of(o)))
+    s << gnuplot_png_preamble(dir / "joints.png") << "set title "
+      << gnuplot_quote("Joint positions — " + enhanced(title_of(o)))
       << "\nset xlabel 't [s]'\nset ylabel 'q_i [rad]'\nplot ";
     for (int i = 0; i < n; ++i) {
-      s << (i ? ", " : "") << d << " using 1:" << col(kQ + i) << " with lines lw 2 title 'q_" << i + 1 << "'";
+      s << (i ? ", " : "") << d << " using 1:" << col(kQ + i) << " with lines lw 2 title 'q_"
+        << i + 1 << "'";
     }
     s << "\n";
     write_script(dir / "joints.gp", s.str());
@@ -379,21 +396,24 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
   const char* axis[] = {"x", "y", "z"};
   {  // Figs. 6 / 8: estimated and true force, and the error norm
     std::ostringstream s;
-    s << gnuplot_png_preamble(dir / "force.png", 1000, 1000)
-      << "set multiplot layout 4,1 title " << gnuplot_quote("External force, world frame — " + enhanced(title_of(o))) << "\n"
+    s << gnuplot_png_preamble(dir / "force.png", 1000, 1000) << "set multiplot layout 4,1 title "
+      << gnuplot_quote("External force, world frame — " + enhanced(title_of(o))) << "\n"
       << "set key inside right top horizontal\nset lmargin 10\n";
     for (int k = 0; k < 3; ++k) {
-      s << "set ylabel 'F_" << axis[k] << " [N]'\nunset xlabel\nplot " << d << " using 1:" << col(kF + k)
-        << " with lines lw 2 lc rgb '#1f77b4' title 'estimated'";
-      if (truth) s << ", " << d << " using 1:" << col(kFt + k) << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true'";
+      s << "set ylabel 'F_" << axis[k] << " [N]'\nunset xlabel\nplot " << d
+        << " using 1:" << col(kF + k) << " with lines lw 2 lc rgb '#1f77b4' title 'estimated'";
+      if (truth)
+        s << ", " << d << " using 1:" << col(kFt + k)
+          << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true'";
       s << "\n";
     }
     if (truth) {
-      s << "set ylabel '|F_{est} - F| [N]'\nset xlabel 't [s]'\nset logscale y\nplot " << d << " using 1:"
-        << col(kErrF) << " with lines lw 2 lc rgb '#2ca02c' title 'force error'\nunset logscale y\n";
+      s << "set ylabel '|F_{est} - F| [N]'\nset xlabel 't [s]'\nset logscale y\nplot " << d
+        << " using 1:" << col(kErrF)
+        << " with lines lw 2 lc rgb '#2ca02c' title 'force error'\nunset logscale y\n";
     } else {
-      s << "set ylabel 'contact'\nset xlabel 't [s]'\nset yrange [-0.1:1.1]\nplot " << d << " using 1:"
-        << col(kContact) << " with steps lw 2 title 'contact detected'\n";
+      s << "set ylabel 'contact'\nset xlabel 't [s]'\nset yrange [-0.1:1.1]\nplot " << d
+        << " using 1:" << col(kContact) << " with steps lw 2 title 'contact detected'\n";
     }
     s << "unset multiplot\n";
     write_script(dir / "force.gp", s.str());
@@ -404,12 +424,17 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     std::ostringstream s;
     s << gnuplot_png_preamble(dir / "line_point.png", 1000, 850)
       << "set multiplot layout 3,1 title "
-      << gnuplot_quote("Point of the line of action p̂ (eq. 20), world frame — " + enhanced(title_of(o))) << "\n"
+      << gnuplot_quote("Point of the line of action p̂ (eq. 20), world frame — " +
+                       enhanced(title_of(o)))
+      << "\n"
       << "set key inside right top horizontal\nset lmargin 10\n";
     for (int k = 0; k < 3; ++k) {
-      s << "set ylabel 'p_" << axis[k] << " [m]'\n" << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n")
-        << "plot " << d << " using 1:" << col(kL + k) << " with lines lw 2 lc rgb '#1f77b4' title 'estimated p̂'";
-      if (truth) s << ", " << d << " using 1:" << col(kPt + k) << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true point'";
+      s << "set ylabel 'p_" << axis[k] << " [m]'\n"
+        << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n") << "plot " << d
+        << " using 1:" << col(kL + k) << " with lines lw 2 lc rgb '#1f77b4' title 'estimated p̂'";
+      if (truth)
+        s << ", " << d << " using 1:" << col(kPt + k)
+          << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true point'";
       s << "\n";
     }
     s << "unset multiplot\n";
@@ -421,11 +446,14 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     std::ostringstream s;
     s << gnuplot_png_preamble(dir / "condition.png", 1000, 600) << "set title "
       << gnuplot_quote("Condition number — " + enhanced(title_of(o)))
-      << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\nset logscale y\nset key inside left top\nplot "
-      << d << " using 1:" << col(kCond) << " with lines lw 2 lc rgb '#1f77b4' title 'Jacobian inverted by the estimator'";
+      << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\nset logscale y\nset key inside "
+         "left top\nplot "
+      << d << " using 1:" << col(kCond)
+      << " with lines lw 2 lc rgb '#1f77b4' title 'Jacobian inverted by the estimator'";
     if (truth) {
       s << ", " << d << " using 1:" << col(kCondTrue)
-        << " with lines lw 2 dt 2 lc rgb '#d62728' title 'J of O_l (world frame, SI), l = true contact link'";
+        << " with lines lw 2 dt 2 lc rgb '#d62728' title 'J of O_l (world frame, SI), l = true "
+           "contact link'";
     }
     s << "\n";
     write_script(dir / "condition.gp", s.str());
@@ -437,11 +465,13 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     const int available = dec.rows();
     const int count = std::max(1, std::min(o.snapshots, available));
     for (int k = 0; k < count && available > 0; ++k) {
-      rows.push_back(static_cast<int>((static_cast<long long>(available - 1) * (2 * k + 1)) / (2 * count)));
+      rows.push_back(
+          static_cast<int>((static_cast<long long>(available - 1) * (2 * k + 1)) / (2 * count)));
     }
     Data data(model);
     std::ofstream out(dir / "robot3d.txt");
-    // Blocks per snapshot (gnuplot index): 4k skeleton, 4k+1 true point, 4k+2 line, 4k+3 surface point.
+    // Blocks per snapshot (gnuplot index): 4k skeleton, 4k+1 true point, 4k+2 line, 4k+3 surface
+    // point.
     double extent = 0.3;
     for (const int r : rows) {
       const double* row = dec.row(r);
@@ -482,24 +512,30 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
     const int cols = rows.size() > 1 ? 2 : 1;
     const int lines = static_cast<int>((rows.size() + 1) / 2);
     s << gnuplot_png_preamble(dir / "robot3d.png", 1100, 550 * std::max(1, lines))
-      << "set multiplot layout " << std::max(1, lines) << "," << cols
-      << " title "
-      << gnuplot_quote("Robot, true contact point and estimated line of action — " + enhanced(title_of(o))) << "\n"
+      << "set multiplot layout " << std::max(1, lines) << "," << cols << " title "
+      << gnuplot_quote("Robot, true contact point and estimated line of action — " +
+                       enhanced(title_of(o)))
+      << "\n"
       << "set view 62,30,1.2\nset view equal xyz\n"
       << "set xrange [" << -extent << ":" << extent << "]\nset yrange [" << -extent << ":" << extent
       << "]\nset zrange [" << std::min(-0.35, p_WS.z() - 0.05) << ":" << extent + 0.1 << "]\n"
-      << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]'\nset key at screen 0.99, screen 0.995 top right samplen 2\n"
+      << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]'\nset key at screen 0.99, "
+         "screen 0.995 top right samplen 2\n"
       << "set ticslevel 0\n";
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const double t = dec.row(rows[k])[kT];
       char buf[64];
       std::snprintf(buf, sizeof buf, "t = %.2f s", t);
       s << "set title '" << buf << "'\n"
-        << "splot 'robot3d.txt' index " << 4 * k << " with linespoints lw 4 pt 7 ps 1 lc rgb '#555555' title "
+        << "splot 'robot3d.txt' index " << 4 * k
+        << " with linespoints lw 4 pt 7 ps 1 lc rgb '#555555' title "
         << (k == 0 ? "'links (sensor, joint frame origins)'" : "''") << ", "
-        << "'' index " << 4 * k + 1 << " with points pt 7 ps 2 lc rgb '#d62728' title " << (k == 0 ? "'true point'" : "''") << ", "
-        << "'' index " << 4 * k + 2 << " with lines lw 3 lc rgb '#1f77b4' title " << (k == 0 ? "'estimated line of action'" : "''") << ", "
-        << "'' index " << 4 * k + 3 << " with points pt 9 ps 2 lc rgb '#2ca02c' title " << (k == 0 ? "'estimated surface point'" : "''") << "\n";
+        << "'' index " << 4 * k + 1 << " with points pt 7 ps 2 lc rgb '#d62728' title "
+        << (k == 0 ? "'true point'" : "''") << ", "
+        << "'' index " << 4 * k + 2 << " with lines lw 3 lc rgb '#1f77b4' title "
+        << (k == 0 ? "'estimated line of action'" : "''") << ", "
+        << "'' index " << 4 * k + 3 << " with points pt 9 ps 2 lc rgb '#2ca02c' title "
+        << (k == 0 ? "'estimated surface point'" : "''") << "\n";
     }
     s << "unset multiplot\n";
     write_script(dir / "robot3d.gp", s.str());
@@ -530,7 +566,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   if (o.warn_ignored_columns && !reader.ignored_columns().empty()) {
     std::string list;
     for (const auto& c : reader.ignored_columns()) list += (list.empty() ? "" : ", ") + c;
-    std::cerr << "extwrench: note: " << reader.name() << ": ignoring columns not in the log format: " << list << "\n";
+    std::cerr << "extwrench: note: " << reader.name()
+              << ": ignoring columns not in the log format: " << list << "\n";
   }
   const SensorType sensor = estimator_options.sensor.type;
   if (sensor == SensorType::kForceTorque && !(layout.force && layout.moment)) {
@@ -538,7 +575,9 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                 (layout.force ? "ms_x, ms_y, ms_z" : "fs_x..fs_z, ms_x..ms_z") + " columns");
   }
   if (sensor == SensorType::kForce && !layout.force) {
-    throw Error(reader.name() + ":1: the configuration's sensor.type is 'force' but the log has no fs_x, fs_y, fs_z columns");
+    throw Error(reader.name() +
+                ":1: the configuration's sensor.type is 'force' but the log has no fs_x, fs_y, "
+                "fs_z columns");
   }
   std::filesystem::create_directories(o.out_dir);
   auto estimator = std::make_unique<ContactEstimator>(model, geometry, estimator_options);
@@ -546,7 +585,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   EstimatesWriter writer(o.out_dir / "estimates.csv", n);
 
   std::vector<ReplayWindow> windows = o.windows;
-  if (windows.empty()) windows.push_back({"whole_log", "every sample of the log", sim::MetricsWindow{}});
+  if (windows.empty())
+    windows.push_back({"whole_log", "every sample of the log", sim::MetricsWindow{}});
   std::vector<sim::MetricsAccumulator> accumulators;
   for (const auto& w : windows) accumulators.emplace_back(w.window);
 
@@ -575,8 +615,9 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
       started = st.ok();
       e = &first;
     } else {
-      const Status st = sensor == SensorType::kNone ? estimator->update(s.t, s.q, s.dq, s.tau)
-                                                   : estimator->update(s.t, s.q, s.dq, s.tau, s.sensor);
+      const Status st = sensor == SensorType::kNone
+                            ? estimator->update(s.t, s.q, s.dq, s.tau)
+                            : estimator->update(s.t, s.q, s.dq, s.tau, s.sensor);
       (void)st;  // reported in the status column
       e = &estimator->result();
     }
@@ -613,7 +654,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
         r[kErrF] = kNaN;
         if (layout.truth) {
           const Vector3 f_true = s.truth.body >= 0 ? s.truth.force : Vector3::Zero();
-          const Vector3 f_est = e->contact && e->has(EstimateFlag::kForce) ? e->force_W : Vector3::Zero();
+          const Vector3 f_est =
+              e->contact && e->has(EstimateFlag::kForce) ? e->force_W : Vector3::Zero();
           r[kErrF] = (f_est - f_true).norm();
         }
         for (int i = 0; i < n; ++i) r[kQ + i] = s.q[i];
@@ -643,7 +685,9 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     }
     write_metrics_json(o.out_dir / "metrics.json", report);
   }
-  if (o.figures) result.figures = make_figures(model, dec, o, layout.truth, estimator_options.sensor.pose.translation);
+  if (o.figures)
+    result.figures =
+        make_figures(model, dec, o, layout.truth, estimator_options.sensor.pose.translation);
   return result;
 }
 

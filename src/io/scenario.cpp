@@ -25,13 +25,16 @@ class Yaml {
  public:
   explicit Yaml(std::string file) : file_(std::move(file)) {}
 
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& key, const std::string& what) const {
+  [[noreturn]] void fail(const YAML::Node& node, const std::string& key,
+                         const std::string& what) const {
     std::string where = file_;
-    if (node.IsDefined() && node.Mark().line >= 0) where += ":" + std::to_string(node.Mark().line + 1);
+    if (node.IsDefined() && node.Mark().line >= 0)
+      where += ":" + std::to_string(node.Mark().line + 1);
     throw Error(where + ": " + key + ": " + what);
   }
 
-  void only_keys(const YAML::Node& map, const std::string& prefix, std::initializer_list<const char*> allowed) const {
+  void only_keys(const YAML::Node& map, const std::string& prefix,
+                 std::initializer_list<const char*> allowed) const {
     if (!map.IsMap()) fail(map, prefix.empty() ? "(top level)" : prefix, "expected a mapping");
     const std::set<std::string> ok(allowed.begin(), allowed.end());
     for (const auto& kv : map) {
@@ -63,13 +66,15 @@ class Yaml {
 
   double positive(const YAML::Node& node, const std::string& k) const {
     const double v = number(node, k);
-    if (!(v > 0.0) || !std::isfinite(v)) fail(node, k, "expected a positive number, got " + node.Scalar());
+    if (!(v > 0.0) || !std::isfinite(v))
+      fail(node, k, "expected a positive number, got " + node.Scalar());
     return v;
   }
 
   double non_negative(const YAML::Node& node, const std::string& k) const {
     const double v = number(node, k);
-    if (!(v >= 0.0) || !std::isfinite(v)) fail(node, k, "expected a number >= 0, got " + node.Scalar());
+    if (!(v >= 0.0) || !std::isfinite(v))
+      fail(node, k, "expected a number >= 0, got " + node.Scalar());
     return v;
   }
 
@@ -91,11 +96,13 @@ class Yaml {
   VectorX vector(const YAML::Node& node, const std::string& k, int n) const {
     if (node.IsScalar()) return VectorX::Constant(n, number(node, k));
     if (!node.IsSequence() || static_cast<int>(node.size()) != n) {
-      fail(node, k, "expected " + std::to_string(n) + " numbers (or one for all)" +
-                        (node.IsSequence() ? ", got " + std::to_string(node.size()) : ""));
+      fail(node, k,
+           "expected " + std::to_string(n) + " numbers (or one for all)" +
+               (node.IsSequence() ? ", got " + std::to_string(node.size()) : ""));
     }
     VectorX v(n);
-    for (int i = 0; i < n; ++i) v[i] = number(node[static_cast<std::size_t>(i)], k + "[" + std::to_string(i) + "]");
+    for (int i = 0; i < n; ++i)
+      v[i] = number(node[static_cast<std::size_t>(i)], k + "[" + std::to_string(i) + "]");
     return v;
   }
 
@@ -113,19 +120,25 @@ class Yaml {
 void parse_trajectory(const Yaml& y, const YAML::Node& node, int n, sim::SinusoidalTrajectory& tr) {
   y.only_keys(node, "trajectory", {"offset", "amplitude", "frequency", "phase"});
   tr.offset = node["offset"] ? y.vector(node["offset"], "trajectory.offset", n) : VectorX::Zero(n);
-  tr.amplitude = node["amplitude"] ? y.vector(node["amplitude"], "trajectory.amplitude", n) : VectorX::Zero(n);
-  tr.frequency = node["frequency"] ? y.vector(node["frequency"], "trajectory.frequency", n) : VectorX::Zero(n);
+  tr.amplitude =
+      node["amplitude"] ? y.vector(node["amplitude"], "trajectory.amplitude", n) : VectorX::Zero(n);
+  tr.frequency =
+      node["frequency"] ? y.vector(node["frequency"], "trajectory.frequency", n) : VectorX::Zero(n);
   tr.phase = node["phase"] ? y.vector(node["phase"], "trajectory.phase", n) : VectorX::Zero(n);
   for (int i = 0; i < n; ++i) {
-    if (tr.frequency[i] < 0.0) y.fail(node["frequency"], "trajectory.frequency", "frequencies must be >= 0 [Hz]");
+    if (tr.frequency[i] < 0.0)
+      y.fail(node["frequency"], "trajectory.frequency", "frequencies must be >= 0 [Hz]");
   }
 }
 
-sim::ForceProfile parse_force(const Yaml& y, const YAML::Node& node, const std::string& k, const Model& model) {
-  y.only_keys(node, k, {"frame", "link", "axes", "force", "moment", "point", "start", "end", "ramp"});
+sim::ForceProfile parse_force(const Yaml& y, const YAML::Node& node, const std::string& k,
+                              const Model& model) {
+  y.only_keys(node, k,
+              {"frame", "link", "axes", "force", "moment", "point", "start", "end", "ramp"});
   sim::ForceProfile f;
   if (node["frame"] && node["link"]) y.fail(node, k, "give either 'frame' or 'link', not both");
-  if (!node["frame"] && !node["link"]) y.fail(node, k, "missing key 'frame' (the frame or link the force acts on)");
+  if (!node["frame"] && !node["link"])
+    y.fail(node, k, "missing key 'frame' (the frame or link the force acts on)");
   const YAML::Node fr = node["frame"] ? node["frame"] : node["link"];
   f.frame = y.string(fr, k + ".frame");
   if (!model.find_frame(f.frame)) {
@@ -182,15 +195,19 @@ void parse_sensors(const Yaml& y, const YAML::Node& node, Scenario& s) {
       base.X_RS = Pose::from_xyz_rpy(xyz, rpy);
     }
     if (b["bias"]) base.bias = y.vector(b["bias"], "sensors.base.bias", 6);
-    if (b["force_noise"]) base.force_noise = y.vector(b["force_noise"], "sensors.base.force_noise", 3);
-    if (b["moment_noise"]) base.moment_noise = y.vector(b["moment_noise"], "sensors.base.moment_noise", 3);
+    if (b["force_noise"])
+      base.force_noise = y.vector(b["force_noise"], "sensors.base.force_noise", 3);
+    if (b["moment_noise"])
+      base.moment_noise = y.vector(b["moment_noise"], "sensors.base.moment_noise", 3);
     if ((base.force_noise.array() < 0).any() || (base.moment_noise.array() < 0).any()) {
       y.fail(b, "sensors.base", "noise standard deviations must be >= 0");
     }
   }
   if (const YAML::Node e = node["encoder"]) {
     y.only_keys(e, "sensors.encoder", {"resolution", "velocity", "velocity_cutoff"});
-    if (e["resolution"]) s.simulation.encoder.resolution = y.non_negative(e["resolution"], "sensors.encoder.resolution");
+    if (e["resolution"])
+      s.simulation.encoder.resolution =
+          y.non_negative(e["resolution"], "sensors.encoder.resolution");
     if (e["velocity"]) {
       const std::string v = y.string(e["velocity"], "sensors.encoder.velocity");
       if (v == "exact") {
@@ -198,18 +215,23 @@ void parse_sensors(const Yaml& y, const YAML::Node& node, Scenario& s) {
       } else if (v == "differentiate") {
         s.simulation.encoder.differentiate = true;
       } else {
-        y.fail(e["velocity"], "sensors.encoder.velocity", "expected exact or differentiate, got '" + v + "'");
+        y.fail(e["velocity"], "sensors.encoder.velocity",
+               "expected exact or differentiate, got '" + v + "'");
       }
     }
     if (e["velocity_cutoff"]) {
-      s.simulation.encoder.velocity_cutoff = y.non_negative(e["velocity_cutoff"], "sensors.encoder.velocity_cutoff");
+      s.simulation.encoder.velocity_cutoff =
+          y.non_negative(e["velocity_cutoff"], "sensors.encoder.velocity_cutoff");
     }
   }
-  if (node["log_velocity"]) s.log_velocity = y.boolean(node["log_velocity"], "sensors.log_velocity");
+  if (node["log_velocity"])
+    s.log_velocity = y.boolean(node["log_velocity"], "sensors.log_velocity");
 }
 
 void parse_metrics(const Yaml& y, const YAML::Node& node, Scenario& s) {
-  y.only_keys(node, "metrics", {"from", "exclude", "exclude_around_singularity", "singularity_link", "surface_point"});
+  y.only_keys(
+      node, "metrics",
+      {"from", "exclude", "exclude_around_singularity", "singularity_link", "surface_point"});
   if (node["from"]) s.metrics_from = y.non_negative(node["from"], "metrics.from");
   if (const YAML::Node ex = node["exclude"]) {
     if (!ex.IsSequence()) y.fail(ex, "metrics.exclude", "expected a list of [from, to] intervals");
@@ -221,15 +243,18 @@ void parse_metrics(const Yaml& y, const YAML::Node& node, Scenario& s) {
     }
   }
   if (node["exclude_around_singularity"]) {
-    s.singularity_half_width = y.non_negative(node["exclude_around_singularity"], "metrics.exclude_around_singularity");
+    s.singularity_half_width =
+        y.non_negative(node["exclude_around_singularity"], "metrics.exclude_around_singularity");
   }
   if (node["singularity_link"]) {
     s.singularity_link = y.string(node["singularity_link"], "metrics.singularity_link");
     if (!s.robot.model.find_body(s.singularity_link)) {
-      y.fail(node["singularity_link"], "metrics.singularity_link", "'" + s.singularity_link + "' is not a link of the robot");
+      y.fail(node["singularity_link"], "metrics.singularity_link",
+             "'" + s.singularity_link + "' is not a link of the robot");
     }
   }
-  if (node["surface_point"]) s.surface_metrics = y.boolean(node["surface_point"], "metrics.surface_point");
+  if (node["surface_point"])
+    s.surface_metrics = y.boolean(node["surface_point"], "metrics.surface_point");
 }
 
 }  // namespace
@@ -248,11 +273,13 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& rob
     }
   }
   if (!root.IsDefined() || root.IsNull()) throw Error(file + ": the scenario is empty");
-  y.only_keys(root, "", {"robot", "seed", "seeds", "duration", "sample_time", "substeps", "model_error",
-                         "trajectory", "controller", "forces", "sensors", "metrics", "figures", "schemes"});
+  y.only_keys(root, "",
+              {"robot", "seed", "seeds", "duration", "sample_time", "substeps", "model_error",
+               "trajectory", "controller", "forces", "sensors", "metrics", "figures", "schemes"});
   Scenario s;
   s.source = path;
-  if (!root["robot"]) y.fail(root, "robot", "missing (the robot file, URDF or DH YAML, relative to the scenario)");
+  if (!root["robot"])
+    y.fail(root, "robot", "missing (the robot file, URDF or DH YAML, relative to the scenario)");
   const std::filesystem::path robot = y.string(root["robot"], "robot");
   s.robot_path = robot.is_absolute() ? robot : path.parent_path() / robot;
   std::error_code ec;
@@ -263,7 +290,8 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& rob
   const Model& model = s.robot.model;
   const int n = model.nq();
 
-  if (root["seed"] && root["seeds"]) y.fail(root["seeds"], "seeds", "give either seed or seeds, not both");
+  if (root["seed"] && root["seeds"])
+    y.fail(root["seeds"], "seeds", "give either seed or seeds, not both");
   if (const YAML::Node sd = root["seed"] ? root["seed"] : root["seeds"]) {
     const std::string k = root["seed"] ? "seed" : "seeds";
     s.seeds.clear();
@@ -280,27 +308,34 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& rob
     }
   }
   if (root["duration"]) s.simulation.duration = y.positive(root["duration"], "duration");
-  if (root["sample_time"]) s.simulation.sample_time = y.positive(root["sample_time"], "sample_time");
+  if (root["sample_time"])
+    s.simulation.sample_time = y.positive(root["sample_time"], "sample_time");
   if (root["substeps"]) {
     const double v = y.positive(root["substeps"], "substeps");
-    if (v != std::floor(v) || v > 1000) y.fail(root["substeps"], "substeps", "expected an integer in [1, 1000]");
+    if (v != std::floor(v) || v > 1000)
+      y.fail(root["substeps"], "substeps", "expected an integer in [1, 1000]");
     s.simulation.substeps = static_cast<int>(v);
   }
   if (s.simulation.duration / s.simulation.sample_time > 1e8) {
-    y.fail(root["duration"], "duration", "more than 1e8 samples: reduce duration or increase sample_time");
+    y.fail(root["duration"], "duration",
+           "more than 1e8 samples: reduce duration or increase sample_time");
   }
   if (root["model_error"]) {
     s.model_error = y.non_negative(root["model_error"], "model_error");
-    if (s.model_error >= 0.5) y.fail(root["model_error"], "model_error", "expected a fraction in [0, 0.5), e.g. 0.01 for ±1 %");
+    if (s.model_error >= 0.5)
+      y.fail(root["model_error"], "model_error",
+             "expected a fraction in [0, 0.5), e.g. 0.01 for ±1 %");
   }
-  if (!root["trajectory"]) y.fail(root, "trajectory", "missing (offset, amplitude, frequency, phase per joint)");
+  if (!root["trajectory"])
+    y.fail(root, "trajectory", "missing (offset, amplitude, frequency, phase per joint)");
   parse_trajectory(y, root["trajectory"], n, s.trajectory);
 
   s.gains = sim::pid_gains_triple_pole(n, 10.0);
   s.controller_omega = 10.0;
   if (const YAML::Node c = root["controller"]) {
     y.only_keys(c, "controller", {"omega", "kp", "kd", "ki"});
-    if (c["omega"] && (c["kp"] || c["kd"] || c["ki"])) y.fail(c, "controller", "give omega or kp/kd/ki, not both");
+    if (c["omega"] && (c["kp"] || c["kd"] || c["ki"]))
+      y.fail(c, "controller", "give omega or kp/kd/ki, not both");
     if (c["omega"]) {
       s.controller_omega = y.positive(c["omega"], "controller.omega");
       s.gains = sim::pid_gains_triple_pole(n, s.controller_omega);
@@ -317,23 +352,28 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& rob
   if (const YAML::Node f = root["forces"]) {
     if (!f.IsSequence()) y.fail(f, "forces", "expected a list of forces");
     for (std::size_t i = 0; i < f.size(); ++i) {
-      s.simulation.forces.push_back(parse_force(y, f[i], "forces[" + std::to_string(i) + "]", model));
+      s.simulation.forces.push_back(
+          parse_force(y, f[i], "forces[" + std::to_string(i) + "]", model));
     }
   }
   parse_sensors(y, root["sensors"] ? root["sensors"] : YAML::Node(YAML::NodeType::Map), s);
   if (root["metrics"]) parse_metrics(y, root["metrics"], s);
   if (s.singularity_half_width > 0.0 && s.singularity_link.empty()) {
     if (s.simulation.forces.empty()) {
-      y.fail(root["metrics"], "metrics.exclude_around_singularity", "needs metrics.singularity_link (there is no force)");
+      y.fail(root["metrics"], "metrics.exclude_around_singularity",
+             "needs metrics.singularity_link (there is no force)");
     }
-    const int body = model.frames[static_cast<std::size_t>(*model.find_frame(s.simulation.forces.front().frame))].body;
+    const int body =
+        model.frames[static_cast<std::size_t>(*model.find_frame(s.simulation.forces.front().frame))]
+            .body;
     s.singularity_link = model.bodies[static_cast<std::size_t>(body)].name;
   }
   if (root["figures"]) s.figures = y.boolean(root["figures"], "figures");
 
   const YAML::Node schemes = root["schemes"];
   if (!schemes) y.fail(root, "schemes", "missing (one or more estimator configurations, by name)");
-  if (!schemes.IsMap() || schemes.size() == 0) y.fail(schemes, "schemes", "expected a mapping name -> estimator configuration");
+  if (!schemes.IsMap() || schemes.size() == 0)
+    y.fail(schemes, "schemes", "expected a mapping name -> estimator configuration");
   for (const auto& kv : schemes) {
     const std::string name = kv.first.Scalar();
     const std::string k = "schemes." + name;
@@ -342,7 +382,8 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& rob
     }
     if (!kv.second.IsMap()) y.fail(kv.second, k, "expected an estimator configuration (a mapping)");
     if (kv.second["robot"]) {
-      y.fail(kv.second["robot"], k + ".robot", "schemes use the scenario's perturbed model; remove 'robot'");
+      y.fail(kv.second["robot"], k + ".robot",
+             "schemes use the scenario's perturbed model; remove 'robot'");
     }
     if (!kv.second["sensor"] || !kv.second["sensor"]["type"]) {
       y.fail(kv.second, k + ".sensor.type", "missing (ft, force or none)");
@@ -358,9 +399,10 @@ namespace {
 
 std::string pose_yaml(const Pose& X) {
   const Vector3 rpy = rpy_from_rotation(X.rotation);
-  return "{xyz: [" + CsvWriter::format(X.translation.x()) + ", " + CsvWriter::format(X.translation.y()) + ", " +
-         CsvWriter::format(X.translation.z()) + "], rpy: [" + CsvWriter::format(rpy.x()) + ", " +
-         CsvWriter::format(rpy.y()) + ", " + CsvWriter::format(rpy.z()) + "]}";
+  return "{xyz: [" + CsvWriter::format(X.translation.x()) + ", " +
+         CsvWriter::format(X.translation.y()) + ", " + CsvWriter::format(X.translation.z()) +
+         "], rpy: [" + CsvWriter::format(rpy.x()) + ", " + CsvWriter::format(rpy.y()) + ", " +
+         CsvWriter::format(rpy.z()) + "]}";
 }
 
 /// The scheme's configuration file: its own keys, plus the robot (the perturbed model written
@@ -370,28 +412,31 @@ std::string scheme_config(const Scenario& s, const SchemeSpec& scheme) {
   YAML::Node out(YAML::NodeType::Map);
   out["robot"] = "../model_estimator.urdf";
   const Vector3& g = s.robot.model.gravity;
-  out["gravity"] = YAML::Load("[" + CsvWriter::format(g.x()) + ", " + CsvWriter::format(g.y()) + ", " +
-                              CsvWriter::format(g.z()) + "]");
+  out["gravity"] = YAML::Load("[" + CsvWriter::format(g.x()) + ", " + CsvWriter::format(g.y()) +
+                              ", " + CsvWriter::format(g.z()) + "]");
   for (const auto& kv : node) out[kv.first.Scalar()] = kv.second;
   if (out["sensor"]["type"].Scalar() != "none" && !out["sensor"]["pose"]) {
     out["sensor"]["pose"] = YAML::Load(pose_yaml(s.simulation.sensor.X_RS));
   }
   YAML::Emitter e;
   e << out;
-  return std::string("# Written by extwrench simulate from ") + s.source.filename().string() + ", scheme '" +
-         scheme.name + "'.\n# Replay: extwrench estimate --config config.yaml --log ../log.csv --out DIR\n" +
+  return std::string("# Written by extwrench simulate from ") + s.source.filename().string() +
+         ", scheme '" + scheme.name +
+         "'.\n# Replay: extwrench estimate --config config.yaml --log ../log.csv --out DIR\n" +
          e.c_str() + "\n";
 }
 
 class SimProgress {
  public:
-  SimProgress(bool on, long total, std::string label) : on_(on), total_(total), label_(std::move(label)) {}
+  SimProgress(bool on, long total, std::string label)
+      : on_(on), total_(total), label_(std::move(label)) {}
   void update(long k) {
     if (!on_ || (k & 255) != 0) return;
     const auto now = std::chrono::steady_clock::now();
     if (now - last_ < std::chrono::milliseconds(200)) return;
     last_ = now;
-    std::fprintf(stderr, "\r  %s: simulating %3.0f %%   ", label_.c_str(), 100.0 * static_cast<double>(k) / static_cast<double>(total_));
+    std::fprintf(stderr, "\r  %s: simulating %3.0f %%   ", label_.c_str(),
+                 100.0 * static_cast<double>(k) / static_cast<double>(total_));
     std::fflush(stderr);
     shown_ = true;
   }
@@ -435,13 +480,15 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
       try {
         configs.push_back(load_estimator_config(cfg));
       } catch (const Error& e) {
-        throw Error(s.source.string() + ":" + std::to_string(scheme.line) + ": scheme '" + scheme.name + "': " + e.what());
+        throw Error(s.source.string() + ":" + std::to_string(scheme.line) + ": scheme '" +
+                    scheme.name + "': " + e.what());
       }
     }
 
     sim::SimulationConfig sc = s.simulation;
     sc.noise_seed = 2 * seed + 1;
-    sim::Simulator simulator(model, sim::ComputedTorqueController(believed, s.trajectory, s.gains), sc);
+    sim::Simulator simulator(model, sim::ComputedTorqueController(believed, s.trajectory, s.gains),
+                             sc);
     LogLayout layout;
     layout.n = model.nq();
     layout.velocity = s.log_velocity;
@@ -453,7 +500,8 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
       LogWriter log(r.dir / "log.csv", layout);
       sim::Sample sample;
       Data data(model);
-      SimProgress progress(options.progress, simulator.num_samples(), "seed " + std::to_string(seed));
+      SimProgress progress(options.progress, simulator.num_samples(),
+                           "seed " + std::to_string(seed));
       while (simulator.next(sample)) {
         log.write(sample);
         if (singular_body > 0) {
@@ -472,15 +520,20 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
 
     std::vector<ReplayWindow> windows;
     const std::string from = CsvWriter::format(s.metrics_from);
-    sim::MetricsWindow after{s.metrics_from, std::numeric_limits<double>::infinity(), s.metrics_exclude};
-    windows.push_back({"after_transient", "t >= " + from + " s (after the residual's transient)", after});
+    sim::MetricsWindow after{s.metrics_from, std::numeric_limits<double>::infinity(),
+                             s.metrics_exclude};
+    windows.push_back(
+        {"after_transient", "t >= " + from + " s (after the residual's transient)", after});
     if (s.singularity_half_width > 0.0 && singular_body > 0) {
       sim::MetricsWindow outside = after;
-      outside.exclude.emplace_back(r.peak_time - s.singularity_half_width, r.peak_time + s.singularity_half_width);
+      outside.exclude.emplace_back(r.peak_time - s.singularity_half_width,
+                                   r.peak_time + s.singularity_half_width);
       char buf[256];
       std::snprintf(buf, sizeof buf,
-                    "t >= %s s, excluding ±%g s around the peak of cond(J of O_l), l = %s (%.4g at t = %.3f s)",
-                    from.c_str(), s.singularity_half_width, s.singularity_link.c_str(), r.peak_condition, r.peak_time);
+                    "t >= %s s, excluding ±%g s around the peak of cond(J of O_l), l = %s (%.4g at "
+                    "t = %.3f s)",
+                    from.c_str(), s.singularity_half_width, s.singularity_link.c_str(),
+                    r.peak_condition, r.peak_time);
       windows.push_back({"outside_singularity", buf, outside});
     }
     for (std::size_t i = 0; i < s.schemes.size(); ++i) {
@@ -496,7 +549,8 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
       ro.warn_ignored_columns = false;
       // Straight from the files just written, like `extwrench estimate`: nothing else is shared.
       const EstimatorConfig& cfg = configs[i];
-      r.schemes.push_back({s.schemes[i].name, replay_log(cfg.robot.model, cfg.robot.geometry, cfg.options, ro)});
+      r.schemes.push_back(
+          {s.schemes[i].name, replay_log(cfg.robot.model, cfg.robot.geometry, cfg.options, ro)});
     }
     results.push_back(std::move(r));
   }

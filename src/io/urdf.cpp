@@ -1,11 +1,11 @@
 // URDF -> ModelBuilder specs + collision shapes (tinyxml2). Strict: every number we read must be
 // a whole finite number, every required attribute present; errors name file:line, element,
 // attribute and the offending text. The subset and the <capsule> extension: docs/model.md.
+#include <tinyxml2.h>
+
 #include <cstring>
 #include <fstream>
 #include <sstream>
-
-#include <tinyxml2.h>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/robot_loader.hpp"
@@ -23,11 +23,12 @@ class UrdfParser {
  public:
   explicit UrdfParser(std::string file) : file_(std::move(file)) {}
 
-  RobotDescription parse(const std::string& xml, const fs::path& base_dir, const LoadOptions& options) {
+  RobotDescription parse(const std::string& xml, const fs::path& base_dir,
+                         const LoadOptions& options) {
     tinyxml2::XMLDocument doc;
     if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
-      throw Error(file_ + ":" + std::to_string(doc.ErrorLineNum()) + ": not well-formed XML: " +
-                  (doc.ErrorStr() ? doc.ErrorStr() : "unknown error"));
+      throw Error(file_ + ":" + std::to_string(doc.ErrorLineNum()) +
+                  ": not well-formed XML: " + (doc.ErrorStr() ? doc.ErrorStr() : "unknown error"));
     }
     const XMLElement* robot = doc.RootElement();
     if (robot == nullptr || std::strcmp(robot->Name(), "robot") != 0) {
@@ -39,7 +40,8 @@ class UrdfParser {
     if (options.gravity) builder.set_gravity(*options.gravity);
     // Only direct children: <link> inside <gazebo> & co. are not links. Unknown elements
     // (<gazebo>, <transmission>, <material>, <mujoco>, ...) are extensions and ignored.
-    for (const XMLElement* e = robot->FirstChildElement(); e != nullptr; e = e->NextSiblingElement()) {
+    for (const XMLElement* e = robot->FirstChildElement(); e != nullptr;
+         e = e->NextSiblingElement()) {
       if (std::strcmp(e->Name(), "link") == 0) {
         builder.add_link(parse_link(e));
       } else if (std::strcmp(e->Name(), "joint") == 0) {
@@ -48,18 +50,22 @@ class UrdfParser {
     }
     RobotDescription robot_description;
     robot_description.model = builder.build();
-    robot_description.geometry = io_detail::build_geometry(robot_description.model, shapes_, base_dir, options);
+    robot_description.geometry =
+        io_detail::build_geometry(robot_description.model, shapes_, base_dir, options);
     return robot_description;
   }
 
  private:
-  std::string where(const XMLElement* e) const { return file_ + ":" + std::to_string(e->GetLineNum()); }
+  std::string where(const XMLElement* e) const {
+    return file_ + ":" + std::to_string(e->GetLineNum());
+  }
   // "file:line: <inertia> of link 'x'"
   std::string context(const XMLElement* e, const std::string& owner) const {
     return where(e) + ": <" + e->Name() + ">" + (owner.empty() ? "" : " of " + owner);
   }
 
-  [[noreturn]] void fail(const XMLElement* e, const std::string& owner, const std::string& what) const {
+  [[noreturn]] void fail(const XMLElement* e, const std::string& owner,
+                         const std::string& what) const {
     throw Error(context(e, owner) + ": " + what);
   }
 
@@ -69,24 +75,28 @@ class UrdfParser {
     return v;
   }
 
-  const XMLElement* required_child(const XMLElement* e, const char* name, const std::string& owner) const {
+  const XMLElement* required_child(const XMLElement* e, const char* name,
+                                   const std::string& owner) const {
     const XMLElement* c = e->FirstChildElement(name);
     if (c == nullptr) fail(e, owner, std::string("missing element <") + name + ">");
     return c;
   }
 
-  double number(const XMLElement* e, const char* attr, const std::string& owner, std::optional<double> fallback) const {
+  double number(const XMLElement* e, const char* attr, const std::string& owner,
+                std::optional<double> fallback) const {
     const char* v = e->Attribute(attr);
     if (v == nullptr) {
       if (fallback) return *fallback;
       fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
     }
     const auto d = io_detail::parse_double(v);
-    if (!d) fail(e, owner, std::string("attribute '") + attr + "': expected a number, got '" + v + "'");
+    if (!d)
+      fail(e, owner, std::string("attribute '") + attr + "': expected a number, got '" + v + "'");
     return *d;
   }
 
-  Vector3 vector3(const XMLElement* e, const char* attr, const std::string& owner, std::optional<Vector3> fallback) const {
+  Vector3 vector3(const XMLElement* e, const char* attr, const std::string& owner,
+                  std::optional<Vector3> fallback) const {
     const char* v = e->Attribute(attr);
     if (v == nullptr) {
       if (fallback) return *fallback;
@@ -100,7 +110,8 @@ class UrdfParser {
       ok = d.has_value();
       if (ok) out[static_cast<Eigen::Index>(i)] = *d;
     }
-    if (!ok) fail(e, owner, std::string("attribute '") + attr + "': expected 3 numbers, got '" + v + "'");
+    if (!ok)
+      fail(e, owner, std::string("attribute '") + attr + "': expected 3 numbers, got '" + v + "'");
     return out;
   }
 
@@ -108,7 +119,8 @@ class UrdfParser {
   Pose origin(const XMLElement* parent, const std::string& owner) const {
     const XMLElement* o = parent->FirstChildElement("origin");
     if (o == nullptr) return Pose::identity();
-    return Pose::from_xyz_rpy(vector3(o, "xyz", owner, Vector3::Zero()), vector3(o, "rpy", owner, Vector3::Zero()));
+    return Pose::from_xyz_rpy(vector3(o, "xyz", owner, Vector3::Zero()),
+                              vector3(o, "rpy", owner, Vector3::Zero()));
   }
 
   LinkSpec parse_link(const XMLElement* e) {
@@ -117,13 +129,17 @@ class UrdfParser {
     link.name = required(e, "name", "");
     const std::string owner = "link '" + link.name + "'";
     if (const XMLElement* inertial = e->FirstChildElement("inertial")) {
-      // URDF gives the inertia about the CoM in the <inertial><origin> frame: move it to the link frame.
+      // URDF gives the inertia about the CoM in the <inertial><origin> frame: move it to the link
+      // frame.
       const Pose X_link_inertial = origin(inertial, owner);
       const XMLElement* mass = required_child(inertial, "mass", owner);
       const XMLElement* inertia = required_child(inertial, "inertia", owner);
       Inertia in;
       in.mass = number(mass, "value", owner, std::nullopt);
-      if (in.mass < 0.0) fail(mass, owner, std::string("attribute 'value': must not be negative, got '") + mass->Attribute("value") + "'");
+      if (in.mass < 0.0)
+        fail(mass, owner,
+             std::string("attribute 'value': must not be negative, got '") +
+                 mass->Attribute("value") + "'");
       const double ixx = number(inertia, "ixx", owner, std::nullopt);
       const double ixy = number(inertia, "ixy", owner, std::nullopt);
       const double ixz = number(inertia, "ixz", owner, std::nullopt);
@@ -134,7 +150,8 @@ class UrdfParser {
       link.inertia = in.transformed(X_link_inertial);
       link.inertia_source = where(inertia) + ": <inertial>";
     }
-    for (const XMLElement* c = e->FirstChildElement("collision"); c != nullptr; c = c->NextSiblingElement("collision")) {
+    for (const XMLElement* c = e->FirstChildElement("collision"); c != nullptr;
+         c = c->NextSiblingElement("collision")) {
       parse_collision(c, link.name, owner);
     }
     return link;
@@ -143,7 +160,8 @@ class UrdfParser {
   void parse_collision(const XMLElement* c, const std::string& link, const std::string& owner) {
     const XMLElement* geometry = required_child(c, "geometry", owner);
     const XMLElement* g = geometry->FirstChildElement();
-    if (g == nullptr) fail(geometry, owner, "missing shape (sphere, box, cylinder, capsule or mesh)");
+    if (g == nullptr)
+      fail(geometry, owner, "missing shape (sphere, box, cylinder, capsule or mesh)");
     io_detail::ShapeSpec spec;
     spec.frame = link;
     spec.source = context(g, owner);
@@ -152,7 +170,10 @@ class UrdfParser {
     const std::string type = g->Name();
     auto positive = [&](const char* attr) {
       const double v = number(g, attr, owner, std::nullopt);
-      if (!(v > 0.0)) fail(g, owner, std::string("attribute '") + attr + "': must be positive, got '" + g->Attribute(attr) + "'");
+      if (!(v > 0.0))
+        fail(g, owner,
+             std::string("attribute '") + attr + "': must be positive, got '" + g->Attribute(attr) +
+                 "'");
       return v;
     };
     if (type == "sphere") {
@@ -161,23 +182,31 @@ class UrdfParser {
     } else if (type == "box") {
       s.type = ShapeType::kBox;
       s.size = vector3(g, "size", owner, std::nullopt);
-      if (!(s.size.minCoeff() > 0.0)) fail(g, owner, std::string("attribute 'size': must be positive, got '") + g->Attribute("size") + "'");
+      if (!(s.size.minCoeff() > 0.0))
+        fail(g, owner,
+             std::string("attribute 'size': must be positive, got '") + g->Attribute("size") + "'");
     } else if (type == "cylinder" || type == "capsule") {
       // <capsule radius length/> is our extension (URDF has none): length excludes the caps.
       s.type = type == "cylinder" ? ShapeType::kCylinder : ShapeType::kCapsule;
       s.radius = positive("radius");
       s.length = number(g, "length", owner, std::nullopt);
       if (s.length < 0.0 || (s.type == ShapeType::kCylinder && s.length == 0.0)) {
-        fail(g, owner, std::string("attribute 'length': must be positive, got '") + g->Attribute("length") + "'");
+        fail(g, owner,
+             std::string("attribute 'length': must be positive, got '") + g->Attribute("length") +
+                 "'");
       }
     } else if (type == "mesh") {
       s.type = ShapeType::kMesh;
       spec.mesh_uri = required(g, "filename", owner);
       if (spec.mesh_uri.empty()) fail(g, owner, "attribute 'filename': must not be empty");
       s.scale = vector3(g, "scale", owner, Vector3::Ones());
-      if (s.scale.cwiseAbs().minCoeff() == 0.0) fail(g, owner, std::string("attribute 'scale': must not be zero, got '") + g->Attribute("scale") + "'");
+      if (s.scale.cwiseAbs().minCoeff() == 0.0)
+        fail(g, owner,
+             std::string("attribute 'scale': must not be zero, got '") + g->Attribute("scale") +
+                 "'");
     } else {
-      fail(g, owner, "unknown geometry <" + type + "> (expected sphere, box, cylinder, capsule or mesh)");
+      fail(g, owner,
+           "unknown geometry <" + type + "> (expected sphere, box, cylinder, capsule or mesh)");
     }
     shapes_.push_back(std::move(spec));
   }
@@ -197,9 +226,12 @@ class UrdfParser {
     } else if (type == "fixed") {
       j.type = JointSpecType::kFixed;
     } else if (type == "floating" || type == "planar") {
-      fail(e, owner, "attribute 'type': unsupported joint type '" + type + "' (only 1-DoF and fixed joints)");
+      fail(e, owner,
+           "attribute 'type': unsupported joint type '" + type + "' (only 1-DoF and fixed joints)");
     } else {
-      fail(e, owner, "attribute 'type': unknown joint type '" + type + "' (expected revolute, continuous, prismatic or fixed)");
+      fail(e, owner,
+           "attribute 'type': unknown joint type '" + type +
+               "' (expected revolute, continuous, prismatic or fixed)");
     }
     j.parent = required(required_child(e, "parent", owner), "link", owner);
     j.child = required(required_child(e, "child", owner), "link", owner);
@@ -207,11 +239,14 @@ class UrdfParser {
     if (const XMLElement* axis = e->FirstChildElement("axis")) {
       j.axis = vector3(axis, "xyz", owner, Vector3::UnitX());
       if (j.type != JointSpecType::kFixed && j.axis.norm() < 1e-12) {
-        fail(axis, owner, std::string("attribute 'xyz': the axis must not be zero, got '") + axis->Attribute("xyz") + "'");
+        fail(axis, owner,
+             std::string("attribute 'xyz': the axis must not be zero, got '") +
+                 axis->Attribute("xyz") + "'");
       }
     }
     const XMLElement* limit = e->FirstChildElement("limit");
-    if (limit == nullptr && (j.type == JointSpecType::kRevolute || j.type == JointSpecType::kPrismatic)) {
+    if (limit == nullptr &&
+        (j.type == JointSpecType::kRevolute || j.type == JointSpecType::kPrismatic)) {
       fail(e, owner, "missing element <limit> (required for " + type + " joints)");
     }
     if (limit != nullptr && j.type != JointSpecType::kFixed) {
@@ -221,12 +256,19 @@ class UrdfParser {
         j.lower = number(limit, "lower", owner, 0.0);
         j.upper = number(limit, "upper", owner, 0.0);
         if (j.lower > j.upper) {
-          fail(limit, owner, std::string("attributes 'lower' > 'upper' ('") + limit->Attribute("lower") + "' > '" +
-                                 limit->Attribute("upper") + "')");
+          fail(limit, owner,
+               std::string("attributes 'lower' > 'upper' ('") + limit->Attribute("lower") +
+                   "' > '" + limit->Attribute("upper") + "')");
         }
       }
-      if (j.effort_limit < 0.0) fail(limit, owner, std::string("attribute 'effort': must not be negative, got '") + limit->Attribute("effort") + "'");
-      if (j.velocity_limit < 0.0) fail(limit, owner, std::string("attribute 'velocity': must not be negative, got '") + limit->Attribute("velocity") + "'");
+      if (j.effort_limit < 0.0)
+        fail(limit, owner,
+             std::string("attribute 'effort': must not be negative, got '") +
+                 limit->Attribute("effort") + "'");
+      if (j.velocity_limit < 0.0)
+        fail(limit, owner,
+             std::string("attribute 'velocity': must not be negative, got '") +
+                 limit->Attribute("velocity") + "'");
     }
     if (const XMLElement* dyn = e->FirstChildElement("dynamics")) {
       j.damping = number(dyn, "damping", owner, 0.0);
@@ -241,7 +283,8 @@ class UrdfParser {
 
 }  // namespace
 
-RobotDescription load_urdf_string(const std::string& xml, const std::string& name, const LoadOptions& options) {
+RobotDescription load_urdf_string(const std::string& xml, const std::string& name,
+                                  const LoadOptions& options) {
   UrdfParser parser(name);
   RobotDescription r = parser.parse(xml, fs::current_path(), options);
   r.source = name;
@@ -254,7 +297,8 @@ RobotDescription load_urdf(const fs::path& path, const LoadOptions& options) {
   std::ostringstream text;
   text << in.rdbuf();
   UrdfParser parser(path.string());
-  RobotDescription r = parser.parse(text.str(), path.parent_path().empty() ? fs::path(".") : path.parent_path(), options);
+  RobotDescription r = parser.parse(
+      text.str(), path.parent_path().empty() ? fs::path(".") : path.parent_path(), options);
   r.source = path;
   return r;
 }

@@ -1,10 +1,10 @@
 #include "extwrench/io/urdf_writer.hpp"
 
+#include <tinyxml2.h>
+
 #include <cmath>
 #include <fstream>
 #include <set>
-
-#include <tinyxml2.h>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/csv.hpp"
@@ -33,15 +33,16 @@ void add_geometry(tinyxml2::XMLElement* collision, const CollisionShape& shape) 
       break;
     case ShapeType::kCylinder:
     case ShapeType::kCapsule: {
-      tinyxml2::XMLElement* e =
-          geometry->InsertNewChildElement(shape.type == ShapeType::kCylinder ? "cylinder" : "capsule");
+      tinyxml2::XMLElement* e = geometry->InsertNewChildElement(
+          shape.type == ShapeType::kCylinder ? "cylinder" : "capsule");
       e->SetAttribute("radius", num(shape.radius).c_str());
       e->SetAttribute("length", num(shape.length).c_str());
       break;
     }
     case ShapeType::kMesh: {
       if (!shape.mesh || shape.mesh->path.empty()) {
-        throw Error("write_urdf: a mesh shape of link '" + shape.link + "' has no file to refer to");
+        throw Error("write_urdf: a mesh shape of link '" + shape.link +
+                    "' has no file to refer to");
       }
       const std::filesystem::path p = std::filesystem::absolute(shape.mesh->path);
       tinyxml2::XMLElement* e = geometry->InsertNewChildElement("mesh");
@@ -102,7 +103,8 @@ std::string write_urdf_string(const Model& model, const GeometryModel& geometry)
     const bool revolute = j.type == JointType::kRevolute;
     joint->SetAttribute("type", revolute ? (unlimited ? "continuous" : "revolute") : "prismatic");
     joint->InsertNewChildElement("parent")->SetAttribute(
-        "link", model.bodies[static_cast<std::size_t>(model.parents[static_cast<std::size_t>(b)])].name.c_str());
+        "link", model.bodies[static_cast<std::size_t>(model.parents[static_cast<std::size_t>(b)])]
+                    .name.c_str());
     joint->InsertNewChildElement("child")->SetAttribute("link", body.name.c_str());
     add_origin(joint, j.placement);
     joint->InsertNewChildElement("axis")->SetAttribute("xyz", vec(j.axis).c_str());
@@ -116,8 +118,10 @@ std::string write_urdf_string(const Model& model, const GeometryModel& geometry)
         limit->SetAttribute("lower", num(std::isfinite(j.lower) ? j.lower : -kUnbounded).c_str());
         limit->SetAttribute("upper", num(std::isfinite(j.upper) ? j.upper : kUnbounded).c_str());
       }
-      limit->SetAttribute("velocity", num(std::isfinite(j.velocity_limit) ? j.velocity_limit : kUnbounded).c_str());
-      limit->SetAttribute("effort", num(std::isfinite(j.effort_limit) ? j.effort_limit : kUnbounded).c_str());
+      limit->SetAttribute(
+          "velocity", num(std::isfinite(j.velocity_limit) ? j.velocity_limit : kUnbounded).c_str());
+      limit->SetAttribute("effort",
+                          num(std::isfinite(j.effort_limit) ? j.effort_limit : kUnbounded).c_str());
     }
     if (j.damping != 0.0 || j.friction != 0.0) {
       tinyxml2::XMLElement* dyn = joint->InsertNewChildElement("dynamics");

@@ -2,12 +2,11 @@
 // bodies in depth-first order), plus the physical-consistency checks of mass properties.
 #include "extwrench/model/model_builder.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cstdio>
 #include <map>
 #include <set>
-
-#include <Eigen/Eigenvalues>
 
 #include "extwrench/core/error.hpp"
 
@@ -30,20 +29,27 @@ std::string num(double v) {
   return buf;
 }
 
-std::string prefix(const std::string& source) { return source.empty() ? std::string() : source + ": "; }
+std::string prefix(const std::string& source) {
+  return source.empty() ? std::string() : source + ": ";
+}
 
 bool finite(const Pose& x) { return x.rotation.allFinite() && x.translation.allFinite(); }
 
 bool is_rotation(const Matrix3& r) {
-  return (r.transpose() * r - Matrix3::Identity()).cwiseAbs().maxCoeff() < 1e-9 && r.determinant() > 0.0;
+  return (r.transpose() * r - Matrix3::Identity()).cwiseAbs().maxCoeff() < 1e-9 &&
+         r.determinant() > 0.0;
 }
 
 const char* type_name(JointSpecType t) {
   switch (t) {
-    case JointSpecType::kRevolute: return "revolute";
-    case JointSpecType::kContinuous: return "continuous";
-    case JointSpecType::kPrismatic: return "prismatic";
-    case JointSpecType::kFixed: return "fixed";
+    case JointSpecType::kRevolute:
+      return "revolute";
+    case JointSpecType::kContinuous:
+      return "continuous";
+    case JointSpecType::kPrismatic:
+      return "prismatic";
+    case JointSpecType::kFixed:
+      return "fixed";
   }
   return "unknown";
 }
@@ -110,7 +116,8 @@ int singular_mass_matrix_body(const Model& model) {
 
 void validate_inertia(const Inertia& inertia, const std::string& where) {
   const std::string p = where.empty() ? std::string() : where + ": ";
-  if (!std::isfinite(inertia.mass)) throw Error(p + "mass: expected a finite number, got " + num(inertia.mass));
+  if (!std::isfinite(inertia.mass))
+    throw Error(p + "mass: expected a finite number, got " + num(inertia.mass));
   if (inertia.mass < 0.0) throw Error(p + "mass: must not be negative, got " + num(inertia.mass));
   if (!inertia.com.allFinite()) throw Error(p + "centre of mass: expected finite numbers");
   const Matrix3& I = inertia.inertia_com;
@@ -120,21 +127,23 @@ void validate_inertia(const Inertia& inertia, const std::string& where) {
   for (int r = 0; r < 3; ++r) {
     for (int c = r + 1; c < 3; ++c) {
       if (std::abs(I(r, c) - I(c, r)) > kInertiaRelTol * scale) {
-        throw Error(p + "inertia: not symmetric (i" + names[r] + names[c] + " = " + num(I(r, c)) + ", i" +
-                    names[c] + names[r] + " = " + num(I(c, r)) + ")");
+        throw Error(p + "inertia: not symmetric (i" + names[r] + names[c] + " = " + num(I(r, c)) +
+                    ", i" + names[c] + names[r] + " = " + num(I(c, r)) + ")");
       }
     }
   }
-  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(0.5 * (I + I.transpose()), Eigen::EigenvaluesOnly);
+  const Eigen::SelfAdjointEigenSolver<Matrix3> eig(0.5 * (I + I.transpose()),
+                                                   Eigen::EigenvaluesOnly);
   const Vector3 l = eig.eigenvalues();  // ascending
-  const std::string moments = "principal moments " + num(l(0)) + ", " + num(l(1)) + ", " + num(l(2));
+  const std::string moments =
+      "principal moments " + num(l(0)) + ", " + num(l(1)) + ", " + num(l(2));
   if (l(0) < -kInertiaRelTol * scale) {
     throw Error(p + "inertia: not positive semi-definite (" + moments + ")");
   }
   // A rigid body's principal moments satisfy I_a + I_b >= I_c (equality: planar body).
   if (l(0) + l(1) < l(2) - kInertiaRelTol * scale) {
-    throw Error(p + "inertia: principal moments violate the triangle inequality (" + moments + ": " +
-                num(l(0)) + " + " + num(l(1)) + " < " + num(l(2)) + ")");
+    throw Error(p + "inertia: principal moments violate the triangle inequality (" + moments +
+                ": " + num(l(0)) + " + " + num(l(1)) + " < " + num(l(2)) + ")");
   }
 }
 
@@ -144,7 +153,8 @@ void validate_model(const Model& model) {
   if (nb == 0) throw Error(p + "no bodies");
   if (model.joints.size() != nb || model.parents.size() != nb) {
     throw Error(p + "bodies, joints and parents differ in size (" + std::to_string(nb) + ", " +
-                std::to_string(model.joints.size()) + ", " + std::to_string(model.parents.size()) + ")");
+                std::to_string(model.joints.size()) + ", " + std::to_string(model.parents.size()) +
+                ")");
   }
   if (model.parents[0] != -1) throw Error(p + "parents[0] must be -1");
   if (!model.gravity.allFinite()) throw Error(p + "gravity: expected finite numbers");
@@ -153,7 +163,8 @@ void validate_model(const Model& model) {
     validate_inertia(model.bodies[i].inertia, p + body);
     if (i == 0) continue;
     if (model.parents[i] < 0 || model.parents[i] >= static_cast<int>(i)) {
-      throw Error(p + body + ": parent " + std::to_string(model.parents[i]) + " is not a lower index");
+      throw Error(p + body + ": parent " + std::to_string(model.parents[i]) +
+                  " is not a lower index");
     }
     const Joint& j = model.joints[i];
     const std::string jn = p + "joint '" + j.name + "'";
@@ -161,8 +172,8 @@ void validate_model(const Model& model) {
       throw Error(jn + ": placement: expected a finite rigid transform");
     }
     if (!j.axis.allFinite() || std::abs(j.axis.norm() - 1.0) > 1e-9) {
-      throw Error(jn + ": axis: expected a unit vector, got (" + num(j.axis.x()) + " " + num(j.axis.y()) + " " +
-                  num(j.axis.z()) + ")");
+      throw Error(jn + ": axis: expected a unit vector, got (" + num(j.axis.x()) + " " +
+                  num(j.axis.y()) + " " + num(j.axis.z()) + ")");
     }
     if (std::isnan(j.lower) || std::isnan(j.upper) || j.lower > j.upper) {
       throw Error(jn + ": limits: lower " + num(j.lower) + " > upper " + num(j.upper));
@@ -175,15 +186,18 @@ void validate_model(const Model& model) {
     }
   }
   for (const Frame& f : model.frames) {
-    if (f.body < 0 || f.body >= static_cast<int>(nb)) throw Error(p + "frame '" + f.name + "': body out of range");
-    if (!finite(f.placement)) throw Error(p + "frame '" + f.name + "': placement: expected finite numbers");
+    if (f.body < 0 || f.body >= static_cast<int>(nb))
+      throw Error(p + "frame '" + f.name + "': body out of range");
+    if (!finite(f.placement))
+      throw Error(p + "frame '" + f.name + "': placement: expected finite numbers");
   }
   const int bad = singular_mass_matrix_body(model);
   if (bad > 0) {
     const auto ub = static_cast<std::size_t>(bad);
-    throw Error(p + "joint '" + model.joints[ub].name + "' (body '" + model.bodies[ub].name +
-                "'): the joint-space mass matrix is not positive definite at q = 0 (the bodies this "
-                "joint moves carry no mass or inertia about its axis)");
+    throw Error(
+        p + "joint '" + model.joints[ub].name + "' (body '" + model.bodies[ub].name +
+        "'): the joint-space mass matrix is not positive definite at q = 0 (the bodies this "
+        "joint moves carry no mass or inertia about its axis)");
   }
 }
 
@@ -203,8 +217,8 @@ Model ModelBuilder::build() const {
       throw Error(where + ": duplicate link name (first defined at " +
                   links_[static_cast<std::size_t>(it->second)].source + ")");
     }
-    validate_inertia(l.inertia, prefix(l.inertia_source.empty() ? l.source : l.inertia_source) + "link '" +
-                                    l.name + "'");
+    validate_inertia(l.inertia, prefix(l.inertia_source.empty() ? l.source : l.inertia_source) +
+                                    "link '" + l.name + "'");
   }
 
   // --- joints: names, endpoints, numbers, one parent per link
@@ -214,10 +228,12 @@ Model ModelBuilder::build() const {
   for (std::size_t k = 0; k < joints_.size(); ++k) {
     const JointSpec& j = joints_[k];
     const std::string where = prefix(j.source) + "joint '" + j.name + "'";
-    if (j.name.empty()) throw Error(prefix(j.source) + "joint: attribute 'name': must not be empty");
+    if (j.name.empty())
+      throw Error(prefix(j.source) + "joint: attribute 'name': must not be empty");
     if (!joint_names.insert(j.name).second) throw Error(where + ": duplicate joint name");
     const auto parent = link_index.find(j.parent);
-    if (parent == link_index.end()) throw Error(where + ": parent: no link named '" + j.parent + "'");
+    if (parent == link_index.end())
+      throw Error(where + ": parent: no link named '" + j.parent + "'");
     const auto child = link_index.find(j.child);
     if (child == link_index.end()) throw Error(where + ": child: no link named '" + j.child + "'");
     if (parent->second == child->second) {
@@ -226,7 +242,8 @@ Model ModelBuilder::build() const {
     int& pj = parent_joint[static_cast<std::size_t>(child->second)];
     if (pj >= 0) {
       throw Error(where + ": child: link '" + j.child + "' already has a parent joint '" +
-                  joints_[static_cast<std::size_t>(pj)].name + "' (" + joints_[static_cast<std::size_t>(pj)].source +
+                  joints_[static_cast<std::size_t>(pj)].name + "' (" +
+                  joints_[static_cast<std::size_t>(pj)].source +
                   "); a link can have only one parent");
     }
     pj = static_cast<int>(k);
@@ -238,12 +255,15 @@ Model ModelBuilder::build() const {
     if (j.type == JointSpecType::kFixed) continue;
     if (!j.axis.allFinite()) throw Error(where + ": axis: expected finite numbers");
     if (j.axis.norm() < kMinAxisNorm) throw Error(where + ": axis: must not be zero");
-    if (std::isnan(j.lower) || std::isnan(j.upper)) throw Error(where + ": limit: lower/upper must be numbers");
+    if (std::isnan(j.lower) || std::isnan(j.upper))
+      throw Error(where + ": limit: lower/upper must be numbers");
     if (j.type != JointSpecType::kContinuous && j.lower > j.upper) {
       throw Error(where + ": limit: lower " + num(j.lower) + " > upper " + num(j.upper));
     }
-    if (!(j.velocity_limit >= 0.0)) throw Error(where + ": limit: velocity must be non-negative, got " + num(j.velocity_limit));
-    if (!(j.effort_limit >= 0.0)) throw Error(where + ": limit: effort must be non-negative, got " + num(j.effort_limit));
+    if (!(j.velocity_limit >= 0.0))
+      throw Error(where + ": limit: velocity must be non-negative, got " + num(j.velocity_limit));
+    if (!(j.effort_limit >= 0.0))
+      throw Error(where + ": limit: effort must be non-negative, got " + num(j.effort_limit));
     if (!std::isfinite(j.damping)) throw Error(where + ": dynamics: damping must be finite");
     if (!std::isfinite(j.friction)) throw Error(where + ": dynamics: friction must be finite");
   }
@@ -261,7 +281,10 @@ Model ModelBuilder::build() const {
     while (seen_at[static_cast<std::size_t>(l)] < 0) {
       seen_at[static_cast<std::size_t>(l)] = static_cast<int>(path.size());
       path.push_back(l);
-      l = link_index.find(joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])].parent)->second;
+      l = link_index
+              .find(joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])]
+                        .parent)
+              ->second;
     }
     std::string chain;
     const int first = seen_at[static_cast<std::size_t>(l)];
@@ -269,15 +292,17 @@ Model ModelBuilder::build() const {
       chain += "'" + links_[static_cast<std::size_t>(path[i])].name + "' -> ";
     }
     chain += "'" + links_[static_cast<std::size_t>(l)].name + "'";
-    const JointSpec& j = joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])];
+    const JointSpec& j =
+        joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])];
     return Error(prefix(j.source) + "joint '" + j.name + "': closes a cycle of links: " + chain);
   };
   if (roots.empty()) throw describe_cycle(0);
   if (roots.size() > 1) {
     const LinkSpec& a = links_[static_cast<std::size_t>(roots[0])];
     const LinkSpec& b = links_[static_cast<std::size_t>(roots[1])];
-    throw Error(prefix(b.source) + "link '" + b.name + "': more than one root link ('" + a.name + "' at " +
-                a.source + " and '" + b.name + "' have no parent joint); the links must form one tree");
+    throw Error(prefix(b.source) + "link '" + b.name + "': more than one root link ('" + a.name +
+                "' at " + a.source + " and '" + b.name +
+                "' have no parent joint); the links must form one tree");
   }
 
   // --- depth-first traversal: a moving joint starts a new body, a fixed one merges its child
@@ -286,8 +311,8 @@ Model ModelBuilder::build() const {
   model.gravity = gravity_;
   struct Item {
     int link;
-    int joint;         // joint whose child is `link`, -1 for the root
-    int parent_body;   // body of the joint's parent link
+    int joint;                // joint whose child is `link`, -1 for the root
+    int parent_body;          // body of the joint's parent link
     Pose X_body_parent_link;  // pose of the parent link in that body
   };
   std::vector<Item> stack{{roots[0], -1, -1, Pose::identity()}};
@@ -310,7 +335,8 @@ Model ModelBuilder::build() const {
       Joint j;
       if (js != nullptr) {
         j.name = js->name;
-        j.type = js->type == JointSpecType::kPrismatic ? JointType::kPrismatic : JointType::kRevolute;
+        j.type =
+            js->type == JointSpecType::kPrismatic ? JointType::kPrismatic : JointType::kRevolute;
         j.placement = it.X_body_parent_link * js->origin;
         j.axis = js->axis.normalized();
         if (js->type != JointSpecType::kContinuous) {
@@ -321,8 +347,8 @@ Model ModelBuilder::build() const {
         j.effort_limit = js->effort_limit;
         j.damping = js->damping;
         j.friction = js->friction;
-        body_source.push_back(prefix(js->source) + "joint '" + js->name + "' (" + type_name(js->type) +
-                              ") moving link '" + l.name + "'");
+        body_source.push_back(prefix(js->source) + "joint '" + js->name + "' (" +
+                              type_name(js->type) + ") moving link '" + l.name + "'");
       } else {
         body_source.push_back(prefix(l.source) + "link '" + l.name + "'");
       }
@@ -348,7 +374,8 @@ Model ModelBuilder::build() const {
   for (const FrameSpec& f : frames_) {
     const std::string where = prefix(f.source) + "frame '" + f.name + "'";
     if (f.name.empty()) throw Error(prefix(f.source) + "frame: name must not be empty");
-    if (model.find_frame(f.name)) throw Error(where + ": duplicate frame name (a link or frame has it already)");
+    if (model.find_frame(f.name))
+      throw Error(where + ": duplicate frame name (a link or frame has it already)");
     const auto lf = model.find_frame(f.link);
     if (!lf) throw Error(where + ": link: no link or frame named '" + f.link + "'");
     if (!finite(f.placement) || !is_rotation(f.placement.rotation)) {
@@ -361,10 +388,11 @@ Model ModelBuilder::build() const {
   // --- a massless body is fine only if M(q = 0) stays positive definite
   const int bad = singular_mass_matrix_body(model);
   if (bad > 0) {
-    throw Error(body_source[static_cast<std::size_t>(bad)] +
-                ": the joint-space mass matrix is not positive definite at q = 0: the links this joint "
-                "moves carry no mass or inertia about its axis (give the child link an <inertial>, or "
-                "make the joint fixed)");
+    throw Error(
+        body_source[static_cast<std::size_t>(bad)] +
+        ": the joint-space mass matrix is not positive definite at q = 0: the links this joint "
+        "moves carry no mass or inertia about its axis (give the child link an <inertial>, or "
+        "make the joint fixed)");
   }
   validate_model(model);
   return model;

@@ -24,7 +24,8 @@ JointFriction JointFriction::from_model(const Model& model) {
 }
 
 bool JointFriction::is_zero() const noexcept {
-  return (viscous.size() == 0 || viscous.isZero(0.0)) && (coulomb.size() == 0 || coulomb.isZero(0.0));
+  return (viscous.size() == 0 || viscous.isZero(0.0)) &&
+         (coulomb.size() == 0 || coulomb.isZero(0.0));
 }
 
 void friction_torque(const JointFriction& friction, const Eigen::Ref<const VectorX>& dq,

@@ -34,7 +34,8 @@ VectorX expand_gains(const VectorX& gains, int n) {
 }
 
 bool finite_inertia(const Inertia& in) noexcept {
-  return std::isfinite(in.mass) && in.mass >= 0.0 && in.com.allFinite() && in.inertia_com.allFinite();
+  return std::isfinite(in.mass) && in.mass >= 0.0 && in.com.allFinite() &&
+         in.inertia_com.allFinite();
 }
 
 }  // namespace
@@ -97,7 +98,8 @@ void MomentumObserver::apply_payload(int body, const Inertia* payload) noexcept 
 }
 
 Status MomentumObserver::set_payload(int body, const Inertia& payload) noexcept {
-  if (body < 0 || body >= model_.num_bodies()) return {StatusCode::kWrongSize, Channel::kNone, body};
+  if (body < 0 || body >= model_.num_bodies())
+    return {StatusCode::kWrongSize, Channel::kNone, body};
   if (!finite_inertia(payload)) return {StatusCode::kNonFinite, Channel::kNone, body};
   apply_payload(body, &payload);
   return Status::success();
@@ -182,7 +184,7 @@ void MomentumObserver::advance(double t, const Eigen::Ref<const VectorX>& q,
     alpha_ = (-gains_ * dt).array().exp();  // e^{−K Δt}, recomputed only when Δt changes
     alpha_dt_ = dt;
   }
-  if (!have_tau_) tau_prev_ = tau;  // reset without τ: the first interval uses this sample's
+  if (!have_tau_) tau_prev_ = tau;      // reset without τ: the first interval uses this sample's
   const VectorX& tau_hold = tau_prev_;  // zero-order hold of τ over [t_k, t_{k+1})
   const VectorX& m = data_.momentum;
   const double inv_dt = 1.0 / dt;

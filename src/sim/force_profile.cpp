@@ -9,7 +9,9 @@ namespace extwrench::sim {
 
 void ForceProfile::resolve(const Model& model) {
   const auto f = model.find_frame(frame);
-  if (!f) throw Error("force profile: frame '" + frame + "' is not a frame of robot '" + model.name + "'");
+  if (!f)
+    throw Error("force profile: frame '" + frame + "' is not a frame of robot '" + model.name +
+                "'");
   const Frame& fr = model.frames[static_cast<std::size_t>(*f)];
   body = fr.body;
   X_BF = fr.placement;

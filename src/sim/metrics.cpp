@@ -23,8 +23,9 @@ double ErrorStat::rms() const noexcept {
 }
 
 double Metrics::isolation_accuracy() const noexcept {
-  return contact_samples > 0 ? static_cast<double>(right_link) / static_cast<double>(contact_samples)
-                             : std::nan("");
+  return contact_samples > 0
+             ? static_cast<double>(right_link) / static_cast<double>(contact_samples)
+             : std::nan("");
 }
 double Metrics::false_alarm_rate() const noexcept {
   return free_samples > 0 ? static_cast<double>(false_alarms) / static_cast<double>(free_samples)
@@ -94,7 +95,8 @@ void MetricsAccumulator::add(double t, const TruthSample& truth,
   } else {
     ++m_.line_not_estimated;
   }
-  if (est.contact && est.has_surface_point) m_.surface.add((est.surface_point - truth.point).norm());
+  if (est.contact && est.has_surface_point)
+    m_.surface.add((est.surface_point - truth.point).norm());
 }
 
 Metrics MetricsAccumulator::result() const { return m_; }

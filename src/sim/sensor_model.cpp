@@ -28,8 +28,9 @@ void JointSensor::measure(double t, const VectorX& q, const VectorX& dq, VectorX
   } else {
     const double dt = t - last_t_;
     // Backward difference, then an optional first-order low-pass (exact discretization).
-    const double alpha =
-        model_.velocity_cutoff > 0.0 ? 1.0 - std::exp(-2.0 * std::numbers::pi * model_.velocity_cutoff * dt) : 1.0;
+    const double alpha = model_.velocity_cutoff > 0.0
+                             ? 1.0 - std::exp(-2.0 * std::numbers::pi * model_.velocity_cutoff * dt)
+                             : 1.0;
     for (Eigen::Index i = 0; i < q.size(); ++i) {
       const double raw = (q_out[i] - last_q_[i]) / dt;
       dq_out[i] = last_dq_[i] + alpha * (raw - last_dq_[i]);

@@ -12,15 +12,15 @@ namespace extwrench::sim {
 
 Rk4Workspace::Rk4Workspace(const Model& model) : data(model), jacobian(6, model.nq()) {
   const int n = model.nq();
-  for (VectorX* v : {&tau_ext, &k1q, &k1v, &k2q, &k2v, &k3q, &k3v, &k4q, &k4v, &qs, &vs, &tau_total}) {
+  for (VectorX* v :
+       {&tau_ext, &k1q, &k1v, &k2q, &k2v, &k3q, &k3v, &k4q, &k4v, &qs, &vs, &tau_total}) {
     v->setZero(n);
   }
   wrenches.reserve(16);
 }
 
 bool true_acceleration(const Model& model, std::span<const ForceProfile> forces, double t,
-                       const VectorX& q, const VectorX& dq, const VectorX& tau,
-                       Rk4Workspace& ws) {
+                       const VectorX& q, const VectorX& dq, const VectorX& tau, Rk4Workspace& ws) {
   forward_kinematics(model, ws.data, q);
   evaluate_forces(forces, t, ws.data, ws.wrenches);
   external_joint_torques(model, ws.data, ws.wrenches, ws.jacobian, ws.tau_ext);
@@ -65,8 +65,9 @@ Simulator::Simulator(const Model& model, ComputedTorqueController controller,
       noise_(config_.noise_seed) {
   const int n = model_.nq();
   if (controller_.model().nq() != n) {
-    throw Error("simulator: the controller's model has " + std::to_string(controller_.model().nq()) +
-                " joints, the robot " + std::to_string(n));
+    throw Error("simulator: the controller's model has " +
+                std::to_string(controller_.model().nq()) + " joints, the robot " +
+                std::to_string(n));
   }
   if (!(config_.sample_time > 0.0) || !std::isfinite(config_.sample_time)) {
     throw Error("simulator: sample_time must be positive");
@@ -81,11 +82,13 @@ Simulator::Simulator(const Model& model, ComputedTorqueController controller,
   VectorX ddq(n);
   controller_.trajectory().evaluate(0.0, q_, dq_, ddq);
   if (config_.q0.size() != 0) {
-    if (config_.q0.size() != n) throw Error("simulator: q0 needs " + std::to_string(n) + " entries");
+    if (config_.q0.size() != n)
+      throw Error("simulator: q0 needs " + std::to_string(n) + " entries");
     q_ = config_.q0;
   }
   if (config_.dq0.size() != 0) {
-    if (config_.dq0.size() != n) throw Error("simulator: dq0 needs " + std::to_string(n) + " entries");
+    if (config_.dq0.size() != n)
+      throw Error("simulator: dq0 needs " + std::to_string(n) + " entries");
     dq_ = config_.dq0;
   }
   qm_.setZero(n);
@@ -147,7 +150,8 @@ bool Simulator::next(Sample& out) {
   const double h = config_.sample_time / config_.substeps;
   for (int s = 0; s < config_.substeps; ++s) {
     if (!rk4_step(model_, config_.forces, t + s * h, h, tau, q_, dq_, ws_)) {
-      throw Error("simulator: the mass matrix is not positive definite near t = " + std::to_string(t));
+      throw Error("simulator: the mass matrix is not positive definite near t = " +
+                  std::to_string(t));
     }
   }
   if (!q_.allFinite() || !dq_.allFinite()) {

@@ -1,6 +1,7 @@
 // The `extwrench` binary, run as a user would: help and version, `info` checked against the
 // URDF read by the test itself, `dynamics` checked against the library called directly, and
 // malformed inputs and command lines with their messages and exit codes.
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -12,8 +13,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -91,8 +90,8 @@ class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() / ("extwrench_cli_" + std::string(info->name()) + "_" +
-                                        std::to_string(::getpid()));
+    dir_ = fs::temp_directory_path() /
+           ("extwrench_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -102,8 +101,8 @@ class Cli : public ::testing::Test {
   RunResult run(const std::string& args, const std::string& stdin_file = "/dev/null") const {
     const fs::path out = dir_ / "stdout.txt";
     const fs::path err = dir_ / "stderr.txt";
-    const std::string command = std::string("'") + EXTWRENCH_CLI + "' " + args + " >'" + out.string() +
-                                "' 2>'" + err.string() + "' <'" + stdin_file + "'";
+    const std::string command = std::string("'") + EXTWRENCH_CLI + "' " + args + " >'" +
+                                out.string() + "' 2>'" + err.string() + "' <'" + stdin_file + "'";
     const int status = std::system(command.c_str());
     RunResult r;
     r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -178,7 +177,8 @@ UrdfFacts read_urdf_facts(const fs::path& urdf) {
   const std::string text = read_text(urdf);
   UrdfFacts facts;
   facts.links = attribute_values(text, "link", "name");
-  for (const std::string& m : attribute_values(text, "mass", "value")) facts.total_mass += std::stod(m);
+  for (const std::string& m : attribute_values(text, "mass", "value"))
+    facts.total_mass += std::stod(m);
   facts.collisions = static_cast<int>(attribute_values(text, "collision", "name").size());
   return facts;
 }
@@ -196,7 +196,8 @@ TEST_F(Cli, InfoOnThePaperArmListsItsLinksAndTotalMass) {
 
   const RunResult r = run("info '" + urdf.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
-  for (const std::string& link : facts.links) EXPECT_TRUE(contains(r.out, "  " + link + "  ")) << link;
+  for (const std::string& link : facts.links)
+    EXPECT_TRUE(contains(r.out, "  " + link + "  ")) << link;
   EXPECT_TRUE(contains(r.out, "joints: 7, serial chain"));
   EXPECT_NEAR(printed_total_mass(r.out), facts.total_mass, 1e-9 * facts.total_mass);
   // SPEC 5: link 0 (2.0 kg), five links of 2.7 kg, 1.7 kg and 0.3 kg.
@@ -243,7 +244,10 @@ TEST_F(Cli, InfoReportsAMissingOrMalformedRobotFileAsAnInputError) {
   EXPECT_EQ(missing.code, kExitInputError);
   EXPECT_TRUE(contains(missing.err, "nope.urdf: no such robot file"));
 
-  write_text(path("bad.urdf"), "<robot name=\"bad\">\n  <link name=\"a\">\n    <inertial><mass value=\"abc\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>\n  </link>\n</robot>\n");
+  write_text(path("bad.urdf"),
+             "<robot name=\"bad\">\n  <link name=\"a\">\n    <inertial><mass "
+             "value=\"abc\"/><inertia ixx=\"1\" iyy=\"1\" izz=\"1\" ixy=\"0\" ixz=\"0\" "
+             "iyz=\"0\"/></inertial>\n  </link>\n</robot>\n");
   const RunResult bad = run("info " + quoted("bad.urdf"));
   EXPECT_EQ(bad.code, kExitInputError);
   EXPECT_TRUE(contains(bad.err, "bad.urdf:3"));
@@ -306,13 +310,15 @@ endsolid tet
 }
 
 TEST_F(Cli, InfoOnThePandaShowsATreeWithItsFingers) {
-  const fs::path panda = fs::path(EXTWRENCH_SHARED_DIR) / "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
+  const fs::path panda = fs::path(EXTWRENCH_SHARED_DIR) /
+                         "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
   if (!fs::exists(panda)) GTEST_SKIP() << "needs " << panda;
   const UrdfFacts facts = read_urdf_facts(panda);
   const RunResult r = run("info '" + panda.string() + "'");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(contains(r.out, "joints: 9, tree"));
-  for (const std::string& link : facts.links) EXPECT_TRUE(contains(r.out, "  " + link + "  ")) << link;
+  for (const std::string& link : facts.links)
+    EXPECT_TRUE(contains(r.out, "  " + link + "  ")) << link;
   EXPECT_NEAR(printed_total_mass(r.out), facts.total_mass, 1e-9 * facts.total_mass);
 }
 
@@ -358,23 +364,26 @@ void write_states(const fs::path& file, const States& s, int n) {
 
 /// Compares the CLI's output with rnea + sensor_reading called here on the same states. The
 /// doubles must match to the bit: same code, same inputs, round-trip formatting both ways.
-void expect_output_matches_library(const fs::path& out_csv, const RobotDescription& robot, const States& s,
-                                   const Pose& X_WS) {
+void expect_output_matches_library(const fs::path& out_csv, const RobotDescription& robot,
+                                   const States& s, const Pose& X_WS) {
   const Model& model = robot.model;
   const int n = model.nq();
   Data data(model);
   CsvReader reader(out_csv);
   std::vector<std::string> expected_header{"t"};
   for (int i = 1; i <= n; ++i) expected_header.push_back("tau" + std::to_string(i));
-  for (const char* c : {"fs_x", "fs_y", "fs_z", "ms_x", "ms_y", "ms_z"}) expected_header.emplace_back(c);
+  for (const char* c : {"fs_x", "fs_y", "fs_z", "ms_x", "ms_y", "ms_z"})
+    expected_header.emplace_back(c);
   ASSERT_EQ(reader.header(), expected_header);
   for (std::size_t k = 0; k < s.t.size(); ++k) {
     ASSERT_TRUE(reader.next_row()) << "row " << k;
     const VectorX tau = rnea(model, data, s.q[k], s.dq[k], s.ddq[k]);
     const Vector6 reading = sensor_reading(data, X_WS);
     EXPECT_EQ(reader.number(0), s.t[k]);
-    for (int i = 0; i < n; ++i) EXPECT_EQ(reader.number(1 + i), tau[i]) << "row " << k << " tau" << i + 1;
-    for (int j = 0; j < 6; ++j) EXPECT_EQ(reader.number(1 + n + j), reading[j]) << "row " << k << " reading " << j;
+    for (int i = 0; i < n; ++i)
+      EXPECT_EQ(reader.number(1 + i), tau[i]) << "row " << k << " tau" << i + 1;
+    for (int j = 0; j < 6; ++j)
+      EXPECT_EQ(reader.number(1 + n + j), reading[j]) << "row " << k << " reading " << j;
   }
   EXPECT_FALSE(reader.next_row());
 }
@@ -410,15 +419,17 @@ TEST_F(Cli, DynamicsUsesTheGivenSensorPoseWithUrdfRollPitchYaw) {
   const States s = random_states(n, kStates, 12);
   write_states(path("states.csv"), s, n);
 
-  const RunResult r = run("dynamics --robot '" + yaml.string() + "' --sensor-pose '0.1, -0.2 0.05 0.3 -0.4 2.5' --in " +
+  const RunResult r = run("dynamics --robot '" + yaml.string() +
+                          "' --sensor-pose '0.1, -0.2 0.05 0.3 -0.4 2.5' --in " +
                           quoted("states.csv") + " --out " + quoted("out.csv"));
   ASSERT_EQ(r.code, 0) << r.err;
   // rpy as in URDF: R = Rz(yaw) Ry(pitch) Rx(roll), built here from angle-axis products.
   Pose X_WS;
   X_WS.translation = Vector3(0.1, -0.2, 0.05);
-  X_WS.rotation = (Eigen::AngleAxisd(2.5, Vector3::UnitZ()) * Eigen::AngleAxisd(-0.4, Vector3::UnitY()) *
-                   Eigen::AngleAxisd(0.3, Vector3::UnitX()))
-                      .toRotationMatrix();
+  X_WS.rotation =
+      (Eigen::AngleAxisd(2.5, Vector3::UnitZ()) * Eigen::AngleAxisd(-0.4, Vector3::UnitY()) *
+       Eigen::AngleAxisd(0.3, Vector3::UnitX()))
+          .toRotationMatrix();
   expect_output_matches_library(path("out.csv"), robot, s, X_WS);
 }
 
@@ -433,7 +444,8 @@ TEST_F(Cli, DynamicsOfAStaticArmReadsItsWeight) {
   s.dq = {VectorX::Zero(n)};
   s.ddq = {VectorX::Zero(n)};
   write_states(path("static.csv"), s, n);
-  const RunResult r = run("dynamics --robot '" + urdf.string() + "' --in " + quoted("static.csv") + " --out -");
+  const RunResult r =
+      run("dynamics --robot '" + urdf.string() + "' --in " + quoted("static.csv") + " --out -");
   ASSERT_EQ(r.code, 0) << r.err;
   std::istringstream in(r.out);
   CsvReader reader(in, "stdout");
@@ -449,7 +461,8 @@ TEST_F(Cli, DynamicsReadsStdinAndWritesStdoutWithADash) {
   const RobotDescription robot = load_robot(yaml);
   const States s = random_states(robot.model.nq(), 3, 13);
   write_states(path("states.csv"), s, robot.model.nq());
-  const RunResult r = run("dynamics --robot '" + yaml.string() + "' --in - --out -", path("states.csv").string());
+  const RunResult r =
+      run("dynamics --robot '" + yaml.string() + "' --in - --out -", path("states.csv").string());
   ASSERT_EQ(r.code, 0) << r.err;
   write_text(path("out.csv"), r.out);
   Pose X_WS;
@@ -466,7 +479,8 @@ TEST_F(Cli, DynamicsRefusesASensorFrameOnAMovingLink) {
   <joint name="mount" type="fixed"><parent link="arm"/><child link="sensor"/></joint>
 </robot>)");
   write_text(path("states.csv"), "t,q1,dq1,ddq1\n0,0,0,0\n");
-  const std::string base = "dynamics --robot " + quoted("arm.urdf") + " --in " + quoted("states.csv") + " --out " + quoted("out.csv");
+  const std::string base = "dynamics --robot " + quoted("arm.urdf") + " --in " +
+                           quoted("states.csv") + " --out " + quoted("out.csv");
   const RunResult r = run(base);
   EXPECT_EQ(r.code, kExitInputError);
   EXPECT_TRUE(contains(r.err, "frame 'sensor' is attached to the moving body 'arm'"));
@@ -504,26 +518,38 @@ TEST_F(Cli, DynamicsReportsMalformedStatesWithFileLineAndColumn) {
   row_q3_bad.replace(row_q3_bad.find("0.1,0.1,0.1"), 11, "0.1,0.1,1.2.3");  // q3 = column 4
   const std::vector<BadInput> cases = {
       {"missing columns", "t,q1\n0,1\n",
-       "bad.csv:1: missing column(s) q2, q3, q4, q5, q6, q7, dq1, dq2, dq3, dq4, dq5, dq6, dq7, ddq1, ddq2, ddq3, ddq4, ddq5, ddq6, ddq7 (the robot has 7 joints"},
-      {"one missing column", no_ddq7 + "\n" + row7() + "\n", "bad.csv:1: missing column(s) ddq7 (the robot has 7 joints"},
-      {"bad number", h + "\n" + row7() + "\n" + row_q3_bad + "\n", "bad.csv:3: column 4 'q3': expected a number, got '1.2.3'"},
-      {"letters in t", h + "\n" + row7("abc") + "\n", "bad.csv:2: column 1 't': expected a number, got 'abc'"},
-      {"empty cell", h + "\n" + row7("") + "\n", "bad.csv:2: column 1 't': empty cell, expected a number"},
-      {"nan", h + "\n" + row7() + "\n" + row7("nan") + "\n", "bad.csv:3: column 1 't': expected a finite number, got 'nan'"},
-      {"short row", h + "\n" + row7() + "\n0,1,2\n", "bad.csv:3: expected 22 cells as in the header, got 3"},
-      {"long row", h + "\n" + row7() + ",5\n", "bad.csv:2: expected 22 cells as in the header, got 23"},
-      {"unterminated quote", h + "\n\"0" + row7().substr(1) + "\n", "bad.csv:2: column 1: unterminated quoted cell"},
+       "bad.csv:1: missing column(s) q2, q3, q4, q5, q6, q7, dq1, dq2, dq3, dq4, dq5, dq6, dq7, "
+       "ddq1, ddq2, ddq3, ddq4, ddq5, ddq6, ddq7 (the robot has 7 joints"},
+      {"one missing column", no_ddq7 + "\n" + row7() + "\n",
+       "bad.csv:1: missing column(s) ddq7 (the robot has 7 joints"},
+      {"bad number", h + "\n" + row7() + "\n" + row_q3_bad + "\n",
+       "bad.csv:3: column 4 'q3': expected a number, got '1.2.3'"},
+      {"letters in t", h + "\n" + row7("abc") + "\n",
+       "bad.csv:2: column 1 't': expected a number, got 'abc'"},
+      {"empty cell", h + "\n" + row7("") + "\n",
+       "bad.csv:2: column 1 't': empty cell, expected a number"},
+      {"nan", h + "\n" + row7() + "\n" + row7("nan") + "\n",
+       "bad.csv:3: column 1 't': expected a finite number, got 'nan'"},
+      {"short row", h + "\n" + row7() + "\n0,1,2\n",
+       "bad.csv:3: expected 22 cells as in the header, got 3"},
+      {"long row", h + "\n" + row7() + ",5\n",
+       "bad.csv:2: expected 22 cells as in the header, got 23"},
+      {"unterminated quote", h + "\n\"0" + row7().substr(1) + "\n",
+       "bad.csv:2: column 1: unterminated quoted cell"},
       {"crlf and blank lines counted", h + "\r\n" + row7() + "\r\n\r\n" + row7("0.1x") + "\r\n",
        "bad.csv:4: column 1 't': expected a number, got '0.1x'"},
-      {"duplicate column", h + ",q1\n", "bad.csv:1: column 23 'q1' appears twice in the header (also column 2)"},
+      {"duplicate column", h + ",q1\n",
+       "bad.csv:1: column 23 'q1' appears twice in the header (also column 2)"},
       {"empty file", "", "bad.csv: empty file: expected a header row"},
-      {"overflow", h + "\n" + row7("1e400") + "\n", "bad.csv:2: column 1 't': number out of the range of a double: '1e400'"},
+      {"overflow", h + "\n" + row7("1e400") + "\n",
+       "bad.csv:2: column 1 't': number out of the range of a double: '1e400'"},
   };
   const std::string robot = "'" + (kModels / "paper_arm.urdf").string() + "'";
   for (const BadInput& c : cases) {
     SCOPED_TRACE(c.what);
     write_text(path("bad.csv"), c.text);
-    const RunResult r = run("dynamics --robot " + robot + " --in " + quoted("bad.csv") + " --out " + quoted("out.csv"));
+    const RunResult r = run("dynamics --robot " + robot + " --in " + quoted("bad.csv") + " --out " +
+                            quoted("out.csv"));
     EXPECT_EQ(r.code, kExitInputError);
     EXPECT_TRUE(contains(r.err, c.expected));
     EXPECT_TRUE(contains(r.err, "extwrench: error: "));
@@ -541,8 +567,9 @@ TEST_F(Cli, DynamicsReportsAMissingStatesFile) {
 
 TEST_F(Cli, DynamicsRejectsAMalformedSensorPoseAsAUsageError) {
   write_text(path("states.csv"), header7() + "\n" + row7() + "\n");
-  const std::string base = "dynamics --robot '" + (kModels / "paper_arm.urdf").string() + "' --in " +
-                           quoted("states.csv") + " --out " + quoted("out.csv") + " --sensor-pose ";
+  const std::string base = "dynamics --robot '" + (kModels / "paper_arm.urdf").string() +
+                           "' --in " + quoted("states.csv") + " --out " + quoted("out.csv") +
+                           " --sensor-pose ";
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"'1 2 3'", "--sensor-pose: 3 number(s) in '1 2 3'"},
       {"'0 0 0 0 0 0 0'", "--sensor-pose: more than six numbers"},

@@ -1,6 +1,8 @@
 // The streaming CSV reader and writer (io/csv.hpp): dialect, strict numbers, error messages
 // naming file, line and column, bit-exact round trip of doubles, streaming across buffer
 // boundaries.
+#include <gtest/gtest.h>
+
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -11,8 +13,6 @@
 #include <streambuf>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/csv.hpp"
@@ -97,7 +97,8 @@ TEST(CsvReader, SkipsBlankLinesBeforeTheHeader) {
 }
 
 TEST(CsvReader, UnquotesQuotedCellsWithSeparatorsQuotesAndSpaces) {
-  std::istringstream in("name,comment,v\n\"link,6\", \"say \"\"hi\"\"\" ,\"  7 \"\n\"\",x,\"\"\"\"\n");
+  std::istringstream in(
+      "name,comment,v\n\"link,6\", \"say \"\"hi\"\"\" ,\"  7 \"\n\"\",x,\"\"\"\"\n");
   CsvReader reader(in, "q.csv");
   ASSERT_TRUE(reader.next_row());
   EXPECT_EQ(reader.cell(0), "link,6");
@@ -117,14 +118,18 @@ TEST(CsvReader, NumberRejectsEmptyNanAndInfinityButNumberOrNanAcceptsThem) {
   EXPECT_TRUE(std::isnan(reader.number_or_nan(1)));
   EXPECT_EQ(reader.number_or_nan(2), std::numeric_limits<double>::infinity());
   EXPECT_EQ(reader.number_or_nan(3), -std::numeric_limits<double>::infinity());
-  EXPECT_EQ(error_of([&] { (void)reader.number(0); }), "n.csv:2: column 1 'a': empty cell, expected a number");
-  EXPECT_EQ(error_of([&] { (void)reader.number(1); }), "n.csv:2: column 2 'b': expected a finite number, got 'nan'");
-  EXPECT_EQ(error_of([&] { (void)reader.number(2); }), "n.csv:2: column 3 'c': expected a finite number, got 'inf'");
+  EXPECT_EQ(error_of([&] { (void)reader.number(0); }),
+            "n.csv:2: column 1 'a': empty cell, expected a number");
+  EXPECT_EQ(error_of([&] { (void)reader.number(1); }),
+            "n.csv:2: column 2 'b': expected a finite number, got 'nan'");
+  EXPECT_EQ(error_of([&] { (void)reader.number(2); }),
+            "n.csv:2: column 3 'c': expected a finite number, got 'inf'");
   // Text is still an error for number_or_nan: only empty and nan mean "missing".
   std::istringstream in2("a\nabc\n");
   CsvReader reader2(in2, "n2.csv");
   ASSERT_TRUE(reader2.next_row());
-  EXPECT_EQ(error_of([&] { (void)reader2.number_or_nan(0); }), "n2.csv:2: column 1 'a': expected a number, got 'abc'");
+  EXPECT_EQ(error_of([&] { (void)reader2.number_or_nan(0); }),
+            "n2.csv:2: column 1 'a': expected a number, got 'abc'");
 }
 
 // Each malformed input with the exact file:line and column text its message must contain.
@@ -137,24 +142,33 @@ struct MalformedCase {
 TEST(CsvReader, MalformedInputsAreReportedWithFileLineAndColumn) {
   const std::vector<MalformedCase> cases = {
       {"letters", "t,q1\n0,1\n0.1,abc\n", "bad.csv:3: column 2 'q1': expected a number, got 'abc'"},
-      {"two decimal points", "t,q1\n0,1.2.3\n", "bad.csv:2: column 2 'q1': expected a number, got '1.2.3'"},
-      {"trailing garbage", "t,q1\n0.5x,1\n", "bad.csv:2: column 1 't': expected a number, got '0.5x'"},
-      {"decimal comma in quotes", "t,q1\n0,\"1,5\"\n", "bad.csv:2: column 2 'q1': expected a number, got '1,5'"},
+      {"two decimal points", "t,q1\n0,1.2.3\n",
+       "bad.csv:2: column 2 'q1': expected a number, got '1.2.3'"},
+      {"trailing garbage", "t,q1\n0.5x,1\n",
+       "bad.csv:2: column 1 't': expected a number, got '0.5x'"},
+      {"decimal comma in quotes", "t,q1\n0,\"1,5\"\n",
+       "bad.csv:2: column 2 'q1': expected a number, got '1,5'"},
       {"hexadecimal", "t,q1\n0,0x10\n", "bad.csv:2: column 2 'q1': expected a number, got '0x10'"},
       {"double sign", "t,q1\n0,+-1\n", "bad.csv:2: column 2 'q1': expected a number, got '+-1'"},
       {"double minus", "t,q1\n0,--1\n", "bad.csv:2: column 2 'q1': expected a number, got '--1'"},
       {"inner space", "t,q1\n0,1 2\n", "bad.csv:2: column 2 'q1': expected a number, got '1 2'"},
       {"empty cell", "t,q1\n0,1\n1,\n", "bad.csv:3: column 2 'q1': empty cell, expected a number"},
-      {"not finite", "t,q1\n0,NaN\n", "bad.csv:2: column 2 'q1': expected a finite number, got 'NaN'"},
-      {"overflow", "t,q1\n0,1e999\n", "bad.csv:2: column 2 'q1': number out of the range of a double: '1e999'"},
-      {"too few cells", "t,q1,q2\n0,1,2\n0,1\n", "bad.csv:3: expected 3 cells as in the header, got 2"},
-      {"too many cells (trailing comma)", "t,q1\n0,1,\n", "bad.csv:2: expected 2 cells as in the header, got 3"},
+      {"not finite", "t,q1\n0,NaN\n",
+       "bad.csv:2: column 2 'q1': expected a finite number, got 'NaN'"},
+      {"overflow", "t,q1\n0,1e999\n",
+       "bad.csv:2: column 2 'q1': number out of the range of a double: '1e999'"},
+      {"too few cells", "t,q1,q2\n0,1,2\n0,1\n",
+       "bad.csv:3: expected 3 cells as in the header, got 2"},
+      {"too many cells (trailing comma)", "t,q1\n0,1,\n",
+       "bad.csv:2: expected 2 cells as in the header, got 3"},
       {"unterminated quote", "t,q1\n0,\"1\n", "bad.csv:2: column 2: unterminated quoted cell"},
-      {"text after a quote", "t,q1\n0,\"1\"2\n", "bad.csv:2: column 2: unexpected text after a closing quote"},
+      {"text after a quote", "t,q1\n0,\"1\"2\n",
+       "bad.csv:2: column 2: unexpected text after a closing quote"},
       {"stray quote", "t,q1\n0,1\"\n", "bad.csv:2: column 2: a quote inside an unquoted cell"},
       {"line counted across CRLF and blank lines", "t,q1\r\n0,1\r\n\r\n\r\n2,x\r\n",
        "bad.csv:5: column 2 'q1': expected a number, got 'x'"},
-      {"duplicate column", "t,q1,q1\n", "bad.csv:1: column 3 'q1' appears twice in the header (also column 2)"},
+      {"duplicate column", "t,q1,q1\n",
+       "bad.csv:1: column 3 'q1' appears twice in the header (also column 2)"},
       {"empty column name", "t,,q1\n", "bad.csv:1: column 2 of the header has an empty name"},
       {"empty file", "", "bad.csv: empty file: expected a header row"},
       {"blank file", "\n \r\n", "bad.csv: empty file: expected a header row"},
@@ -173,7 +187,8 @@ TEST(CsvReader, CutsVeryLongCellsInMessages) {
 }
 
 TEST(CsvReader, ReportsAFileThatCannotBeOpened) {
-  const std::string message = error_of([] { CsvReader reader(std::filesystem::path("/nonexistent/dir/x.csv")); });
+  const std::string message =
+      error_of([] { CsvReader reader(std::filesystem::path("/nonexistent/dir/x.csv")); });
   EXPECT_EQ(message, "/nonexistent/dir/x.csv: cannot open the file for reading");
 }
 
@@ -272,7 +287,8 @@ TEST(CsvWriter, DoublesReadBackBitForBit) {
   for (const double v : values) {
     ASSERT_TRUE(reader.next_row());
     const double back = reader.number(0);
-    ASSERT_EQ(std::bit_cast<std::uint64_t>(back), std::bit_cast<std::uint64_t>(v)) << reader.cell(0);
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(back), std::bit_cast<std::uint64_t>(v))
+        << reader.cell(0);
   }
   EXPECT_FALSE(reader.next_row());
 }
@@ -287,7 +303,11 @@ TEST(CsvWriter, UsesTheShortestTextThatReadsBack) {
 TEST(CsvWriter, WritesNanAsAnEmptyCellAndQuotesTextThatNeedsIt) {
   std::stringstream io;
   CsvWriter writer(io, {"t", "link", "fx", "note"});
-  writer.add(0.5).add("link6").add(std::numeric_limits<double>::quiet_NaN()).add("a, \"b\"").end_row();
+  writer.add(0.5)
+      .add("link6")
+      .add(std::numeric_limits<double>::quiet_NaN())
+      .add("a, \"b\"")
+      .end_row();
   writer.add(1.0).add("").add(-std::numeric_limits<double>::infinity()).add(" padded ").end_row();
   writer.flush();
   EXPECT_EQ(io.str(), "t,link,fx,note\n0.5,link6,,\"a, \"\"b\"\"\"\n1,,-inf,\" padded \"\n");
@@ -312,7 +332,8 @@ TEST(CsvWriter, RejectsARowWithTheWrongNumberOfCellsAndDropsIt) {
   std::stringstream io;
   CsvWriter writer(io, {"a", "b"}, "out.csv");
   writer.add(1.0);
-  EXPECT_TRUE(contains(error_of([&] { writer.end_row(); }), "out.csv: internal error: a row of 1 cells for 2 columns"));
+  EXPECT_TRUE(contains(error_of([&] { writer.end_row(); }),
+                       "out.csv: internal error: a row of 1 cells for 2 columns"));
   writer.add(1.0).add(2.0).end_row();
   writer.flush();
   EXPECT_EQ(io.str(), "a,b\n1,2\n");

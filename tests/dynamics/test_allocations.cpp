@@ -2,10 +2,10 @@
 // without a single heap allocation. Counted by a process-wide malloc / operator new counter
 // (tests/support/alloc_counter.hpp), so std::vector growth or a stray std::string is caught
 // too, not only Eigen's own allocations. No warm-up call: the first call must not allocate either.
+#include <gtest/gtest.h>
+
 #include <array>
 #include <span>
-
-#include <gtest/gtest.h>
 
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -141,18 +141,18 @@ TEST_P(DynamicsAllocations, ForwardDynamicsAllocatesNothing) {
 TEST(AllocationCounter, SeesVectorGrowthSoTheZeroCountsAreMeaningful) {
   if (!test::allocation_counting_available()) GTEST_SKIP() << "sanitizer build";
   const std::size_t count = allocations_in([] {
-    VectorX v = VectorX::Zero(40);  // one Eigen allocation
+    VectorX v = VectorX::Zero(40);                  // one Eigen allocation
     asm volatile("" : : "g"(v.data()) : "memory");  // keep the compiler from eliding it
   });
   EXPECT_GE(count, 1u);
 }
 
 // Sizes around Eigen's blocking thresholds (LLT switches to a blocked algorithm for larger n).
-INSTANTIATE_TEST_SUITE_P(
-    Models, DynamicsAllocations,
-    ::testing::Values(Case{"chain7", {7, false, false, 3}}, Case{"tree12", {12, true, true, 4}},
-                      Case{"chain40", {40, false, true, 5}}),
-    [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Models, DynamicsAllocations,
+                         ::testing::Values(Case{"chain7", {7, false, false, 3}},
+                                           Case{"tree12", {12, true, true, 4}},
+                                           Case{"chain40", {40, false, true, 5}}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace
 }  // namespace extwrench

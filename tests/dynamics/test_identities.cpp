@@ -44,7 +44,8 @@ TEST_P(DynamicsIdentities, MassMatrixDerivativeEqualsCPlusCTranspose) {
     const MatrixX m_minus = crba(model_, data, q - kFdStep * dq);
     const MatrixX b_dot = (m_plus - m_minus) / (2 * kFdStep);
     const MatrixX c = coriolis_matrix(model_, data, q, dq);
-    EXPECT_LE((b_dot - c - c.transpose()).cwiseAbs().maxCoeff(), kFiniteDifferenceTol * scale(b_dot));
+    EXPECT_LE((b_dot - c - c.transpose()).cwiseAbs().maxCoeff(),
+              kFiniteDifferenceTol * scale(b_dot));
   }
 }
 
@@ -169,8 +170,8 @@ TEST_P(DynamicsIdentities, PointJacobianMatchesFiniteDifferencesOfKinematics) {
     const Vector6 twist = J * dq;
     const Vector3 v_fd = (plus.act(p_B) - minus.act(p_B)) / (2 * kFdStep);
     // R_dot R^T = S(w)
-    const Matrix3 w_hat = (plus.rotation - minus.rotation) / (2 * kFdStep) *
-                          data.X_WB[body].rotation.transpose();
+    const Matrix3 w_hat =
+        (plus.rotation - minus.rotation) / (2 * kFdStep) * data.X_WB[body].rotation.transpose();
     const Vector3 w_fd(w_hat(2, 1), w_hat(0, 2), w_hat(1, 0));
     EXPECT_LE((twist.head<3>() - v_fd).norm(), kFiniteDifferenceTol * (1 + v_fd.norm()));
     EXPECT_LE((twist.tail<3>() - w_fd).norm(), kFiniteDifferenceTol * (1 + w_fd.norm()));
@@ -198,7 +199,8 @@ Momenta robot_momenta(const Model& model, Data& data, const VectorX& q, const Ve
     const Vector3 p = in.mass * twist.head<3>();
     const Matrix3 R = data.X_WB[i].rotation;
     out.linear += p;
-    out.angular_about_sensor += (c_W - p_WS).cross(p) + R * in.inertia_com * R.transpose() * twist.tail<3>();
+    out.angular_about_sensor +=
+        (c_W - p_WS).cross(p) + R * in.inertia_com * R.transpose() * twist.tail<3>();
   }
   return out;
 }
@@ -211,15 +213,18 @@ TEST_P(DynamicsIdentities, BaseReadingObeysNewtonEulerForTheWholeRobot) {
   for (int k = 0; k < kStates; ++k) {
     const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
     const VectorX ddq = rng.uniform_vector(n, -5, 5);
-    const Pose X_WS = Pose::from_xyz_rpy(rng.uniform_vector3(-0.5, 0.5), rng.uniform_vector3(-3, 3));
+    const Pose X_WS =
+        Pose::from_xyz_rpy(rng.uniform_vector3(-0.5, 0.5), rng.uniform_vector3(-3, 3));
     ExternalWrench w;
     w.body = k % (n + 1);
     w.force_W = rng.uniform_vector3(-20, 20);
     w.moment_W = rng.uniform_vector3(-5, 5);
     // Along q(t) with the given dq, ddq: second-order Taylor, so the central difference of the
     // momenta at t = 0 is exact to O(h^2).
-    const Momenta plus = robot_momenta(model_, data, q + h * dq + 0.5 * h * h * ddq, dq + h * ddq, X_WS.translation);
-    const Momenta minus = robot_momenta(model_, data, q - h * dq + 0.5 * h * h * ddq, dq - h * ddq, X_WS.translation);
+    const Momenta plus =
+        robot_momenta(model_, data, q + h * dq + 0.5 * h * h * ddq, dq + h * ddq, X_WS.translation);
+    const Momenta minus =
+        robot_momenta(model_, data, q - h * dq + 0.5 * h * h * ddq, dq - h * ddq, X_WS.translation);
     const Vector3 p_dot = (plus.linear - minus.linear) / (2 * h);
     const Vector3 l_dot = (plus.angular_about_sensor - minus.angular_about_sensor) / (2 * h);
 
@@ -242,8 +247,10 @@ TEST_P(DynamicsIdentities, BaseReadingObeysNewtonEulerForTheWholeRobot) {
                                (com - X_WS.translation).cross(weight) - l_dot;
     EXPECT_LE((reading_W.head<3>() - f_expected).norm(), 1e-6 * (1 + f_expected.norm()));
     EXPECT_LE((reading_W.tail<3>() - n_expected).norm(), 1e-6 * (1 + n_expected.norm()));
-    EXPECT_LE((X_WS.rotation * reading_S.head<3>() - reading_W.head<3>()).norm(), 1e-12 * (1 + f_expected.norm()));
-    EXPECT_LE((X_WS.rotation * reading_S.tail<3>() - reading_W.tail<3>()).norm(), 1e-12 * (1 + n_expected.norm()));
+    EXPECT_LE((X_WS.rotation * reading_S.head<3>() - reading_W.head<3>()).norm(),
+              1e-12 * (1 + f_expected.norm()));
+    EXPECT_LE((X_WS.rotation * reading_S.tail<3>() - reading_W.tail<3>()).norm(),
+              1e-12 * (1 + n_expected.norm()));
   }
 }
 
@@ -271,12 +278,14 @@ TEST_P(DynamicsIdentities, StaticRobotDischargesItsWeightAndItsMoment) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    RandomModels, DynamicsIdentities,
-    ::testing::Values(Case{"Chain7", {7, false, false, 1}}, Case{"Tree9", {9, true, false, 2}},
-                      Case{"ChainWithPrismatic6", {6, false, true, 3}},
-                      Case{"TreeWithPrismatic8", {8, true, true, 4}}),
-    [](const ::testing::TestParamInfo<Case>& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(RandomModels, DynamicsIdentities,
+                         ::testing::Values(Case{"Chain7", {7, false, false, 1}},
+                                           Case{"Tree9", {9, true, false, 2}},
+                                           Case{"ChainWithPrismatic6", {6, false, true, 3}},
+                                           Case{"TreeWithPrismatic8", {8, true, true, 4}}),
+                         [](const ::testing::TestParamInfo<Case>& info) {
+                           return std::string(info.param.name);
+                         });
 
 }  // namespace
 }  // namespace extwrench

@@ -10,7 +10,6 @@
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
 #include <kdl/tree.hpp>
 #include <kdl_parser/kdl_parser.hpp>
-
 #include <memory>
 #include <stdexcept>
 
@@ -22,19 +21,23 @@ class KdlReference {
  public:
   explicit KdlReference(const Model& model) : n_(model.nq()) {
     KDL::Tree tree;
-    if (!kdl_parser::treeFromString(model_to_urdf(model), tree)) throw std::runtime_error("kdl_parser failed");
+    if (!kdl_parser::treeFromString(model_to_urdf(model), tree))
+      throw std::runtime_error("kdl_parser failed");
     KDL::Chain arm;
     if (!tree.getChain(model.bodies.front().name, model.bodies.back().name, arm)) {
       throw std::runtime_error("KDL getChain failed");
     }
     const Inertia& in0 = model.bodies[0].inertia;
     const Matrix3& I = in0.inertia_com;
-    const KDL::RigidBodyInertia link0(in0.mass, KDL::Vector(in0.com.x(), in0.com.y(), in0.com.z()),
-                                      KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
-    const KDL::Joint::JointType types[6] = {KDL::Joint::TransX, KDL::Joint::TransY, KDL::Joint::TransZ,
-                                            KDL::Joint::RotX,   KDL::Joint::RotY,   KDL::Joint::RotZ};
+    const KDL::RigidBodyInertia link0(
+        in0.mass, KDL::Vector(in0.com.x(), in0.com.y(), in0.com.z()),
+        KDL::RotationalInertia(I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)));
+    const KDL::Joint::JointType types[6] = {KDL::Joint::TransX, KDL::Joint::TransY,
+                                            KDL::Joint::TransZ, KDL::Joint::RotX,
+                                            KDL::Joint::RotY,   KDL::Joint::RotZ};
     for (int k = 0; k < 6; ++k) {
-      chain_.addSegment(KDL::Segment("virtual" + std::to_string(k), KDL::Joint(types[k]), KDL::Frame::Identity(),
+      chain_.addSegment(KDL::Segment("virtual" + std::to_string(k), KDL::Joint(types[k]),
+                                     KDL::Frame::Identity(),
                                      k == 5 ? link0 : KDL::RigidBodyInertia::Zero()));
     }
     chain_.addChain(arm);
@@ -56,20 +59,22 @@ class KdlReference {
   }
 
   struct Result {
-    VectorX tau;        ///< joint torques needed with the wrench (n)
-    VectorX tau_ext;    ///< J_pᵀ W_ext = τ(no wrench) − τ(wrench) (n)
-    Vector6 reading_W;  ///< [f_m; n_m]: what the robot discharges, world axes, moment about the origin
+    VectorX tau;      ///< joint torques needed with the wrench (n)
+    VectorX tau_ext;  ///< J_pᵀ W_ext = τ(no wrench) − τ(wrench) (n)
+    Vector6
+        reading_W;  ///< [f_m; n_m]: what the robot discharges, world axes, moment about the origin
   };
 
   /// F_W at p_W and the pure moment M_W (world) on body `body`, at (q, q̇, q̈).
-  Result compute(const VectorX& q, const VectorX& dq, const VectorX& ddq, int body, const Vector3& F_W,
-                 const Vector3& p_W, const Vector3& M_W) {
+  Result compute(const VectorX& q, const VectorX& dq, const VectorX& ddq, int body,
+                 const Vector3& F_W, const Vector3& p_W, const Vector3& M_W) {
     const Pose X = compute_body_pose(q, body);
     // KDL wants the wrench on segment `body` in that segment's frame, about its origin.
     const Vector3 F_L = X.rotation.transpose() * F_W;
     const Vector3 M_L = X.rotation.transpose() * (M_W + (p_W - X.translation).cross(F_W));
     KDL::Wrenches with(chain_.getNrOfSegments(), KDL::Wrench::Zero()), none = with;
-    with[5 + body] = KDL::Wrench(KDL::Vector(F_L.x(), F_L.y(), F_L.z()), KDL::Vector(M_L.x(), M_L.y(), M_L.z()));
+    with[5 + body] =
+        KDL::Wrench(KDL::Vector(F_L.x(), F_L.y(), F_L.z()), KDL::Vector(M_L.x(), M_L.y(), M_L.z()));
     KDL::JntArray t_with(6 + n_), t_none(6 + n_);
     id_->CartToJnt(full(q), full(dq), full(ddq), with, t_with);
     id_->CartToJnt(full(q), full(dq), full(ddq), none, t_none);

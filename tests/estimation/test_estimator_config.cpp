@@ -11,7 +11,9 @@
 namespace extwrench {
 namespace {
 
-bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
 
 const std::filesystem::path kDir = std::filesystem::path(EXTWRENCH_TEST_DATA_DIR) / "config";
 
@@ -60,7 +62,8 @@ TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {
 
 TEST(EstimatorConfig, RobotPathIsRelativeToTheConfigFileAndKnownPointLinksResolveByName) {
   const EstimatorConfig c = load_estimator_config(kDir / "known_point_force.yaml");
-  EXPECT_TRUE(std::filesystem::equivalent(c.robot_path, std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf"));
+  EXPECT_TRUE(std::filesystem::equivalent(
+      c.robot_path, std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf"));
   EXPECT_EQ(c.options.sensor.type, SensorType::kForce);
   EXPECT_EQ(c.options.sensor.tare_samples, 100);  // tare: true
   EXPECT_EQ(c.options.contact.model, ContactModel::kKnownPoint);
@@ -74,7 +77,8 @@ TEST(EstimatorConfig, RobotPathIsRelativeToTheConfigFileAndKnownPointLinksResolv
 
 TEST(EstimatorConfig, GravityOfTheConfigOverridesTheRobotFile) {
   const EstimatorConfig c = load_estimator_config_string(
-      "robot: ../../../models/paper_arm.urdf\ngravity: [9.81, 0, 0]\nsensor: {type: ft}\n", kDir / "wall.yaml");
+      "robot: ../../../models/paper_arm.urdf\ngravity: [9.81, 0, 0]\nsensor: {type: ft}\n",
+      kDir / "wall.yaml");
   EXPECT_TRUE(c.robot.model.gravity.isApprox(Vector3(9.81, 0, 0)));
 }
 
@@ -114,9 +118,9 @@ TEST(EstimatorConfig, MakesAWorkingEstimator) {
 
 struct BadConfig {
   const char* yaml;
-  const char* line;   // ":<line>:" expected in the message
-  const char* key;    // key named in the message
-  const char* what;   // part of the explanation
+  const char* line;  // ":<line>:" expected in the message
+  const char* key;   // key named in the message
+  const char* what;  // part of the explanation
 };
 
 class EstimatorConfigErrors : public ::testing::TestWithParam<BadConfig> {};
@@ -141,27 +145,40 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadConfig{"sensor: {type: ft}\nsenser: 1\n", ":3:", "senser", "unknown key"},
         BadConfig{"sensor:\n  type: ft\n  tipe: 2\n", ":4:", "sensor.tipe", "unknown key"},
-        BadConfig{"sensor: {type: laser}\n", ":2:", "sensor.type", "expected one of ft, force, none"},
+        BadConfig{"sensor: {type: laser}\n", ":2:", "sensor.type",
+                  "expected one of ft, force, none"},
         BadConfig{"sensor: {pose: {xyz: [0, 0, 0]}}\n", ":2:", "sensor.type", "missing"},
         BadConfig{"gravity: [0, 0]\nsensor: {type: ft}\n", ":2:", "gravity", "3 numbers"},
-        BadConfig{"sensor:\n  type: ft\n  pose: {xyz: [0, a, 0]}\n", ":4:", "sensor.pose.xyz[1]", "finite number"},
+        BadConfig{"sensor:\n  type: ft\n  pose: {xyz: [0, a, 0]}\n", ":4:", "sensor.pose.xyz[1]",
+                  "finite number"},
         BadConfig{"sensor: {type: ft, tare: -3}\n", ":2:", "sensor.tare", "whole number"},
-        BadConfig{"sensor: {type: none}\nobserver:\n  gain: fast\n", ":4:", "observer.gain", "finite number"},
+        BadConfig{"sensor: {type: none}\nobserver:\n  gain: fast\n", ":4:", "observer.gain",
+                  "finite number"},
         BadConfig{"sensor: {type: none}\nobserver:\n  gain: -5\n", ":4:", "observer.gain", "> 0"},
-        BadConfig{"sensor: {type: none}\ndetection:\n  tau_min: [1, 2, 3]\n", ":4:", "detection.tau_min", "7 values"},
-        BadConfig{"sensor: {type: ft}\ndetection:\n  release_ratio: 1.5\n", ":4:", "detection.release_ratio", "(0, 1]"},
-        BadConfig{"sensor: {type: ft}\ndetection:\n  min_duration: -0.1\n", ":4:", "detection.min_duration", ">= 0"},
+        BadConfig{"sensor: {type: none}\ndetection:\n  tau_min: [1, 2, 3]\n",
+                  ":4:", "detection.tau_min", "7 values"},
+        BadConfig{"sensor: {type: ft}\ndetection:\n  release_ratio: 1.5\n",
+                  ":4:", "detection.release_ratio", "(0, 1]"},
+        BadConfig{"sensor: {type: ft}\ndetection:\n  min_duration: -0.1\n",
+                  ":4:", "detection.min_duration", ">= 0"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: 0\n", ":4:", "detection.f_min", "> 0"},
-        BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n  link: link99\n", ":5:", "contact.link",
-                  "no link named 'link99'"},
-        BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n", ":4:", "contact.link", "missing"},
-        BadConfig{"sensor: {type: ft}\ncontact: {model: guess}\n", ":3:", "contact.model", "pure_force or known_point"},
-        BadConfig{"sensor: {type: ft}\nacceleration: integrate\n", ":3:", "acceleration", "residual or differentiation"},
-        BadConfig{"sensor: {type: ft}\nfriction: {viscous: [1, 2]}\n", ":3:", "friction.viscous", "7 values"},
-        BadConfig{"sensor: {type: ft}\npayload: {link: link7, mass: -1}\n", ":3:", "payload.mass", ">= 0"},
-        BadConfig{"sensor: {type: ft}\npayload: {link: link7, mass: 1, inertia: [1, 0, 0, 1, 0, -1]}\n", ":3:",
-                  "payload.inertia", "payload"},
-        BadConfig{"sensor: {type: ft}\nsolver: {max_condition: 0.5}\n", ":3:", "solver.max_condition", "> 1"},
+        BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n  link: link99\n",
+                  ":5:", "contact.link", "no link named 'link99'"},
+        BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n", ":4:", "contact.link",
+                  "missing"},
+        BadConfig{"sensor: {type: ft}\ncontact: {model: guess}\n", ":3:", "contact.model",
+                  "pure_force or known_point"},
+        BadConfig{"sensor: {type: ft}\nacceleration: integrate\n", ":3:", "acceleration",
+                  "residual or differentiation"},
+        BadConfig{"sensor: {type: ft}\nfriction: {viscous: [1, 2]}\n", ":3:", "friction.viscous",
+                  "7 values"},
+        BadConfig{"sensor: {type: ft}\npayload: {link: link7, mass: -1}\n", ":3:", "payload.mass",
+                  ">= 0"},
+        BadConfig{
+            "sensor: {type: ft}\npayload: {link: link7, mass: 1, inertia: [1, 0, 0, 1, 0, -1]}\n",
+            ":3:", "payload.inertia", "payload"},
+        BadConfig{"sensor: {type: ft}\nsolver: {max_condition: 0.5}\n",
+                  ":3:", "solver.max_condition", "> 1"},
         BadConfig{"sensor: [ft\n", ":", "YAML", "syntax"}));
 
 TEST(EstimatorConfig, MissingRobotOrRobotFileIsAnErrorNamingTheKey) {
@@ -173,7 +190,8 @@ TEST(EstimatorConfig, MissingRobotOrRobotFileIsAnErrorNamingTheKey) {
     EXPECT_TRUE(contains(std::string(e.what()), "robot: missing"));
   }
   try {
-    (void)load_estimator_config_string("robot: nowhere.urdf\nsensor: {type: ft}\n", kDir / "lost.yaml");
+    (void)load_estimator_config_string("robot: nowhere.urdf\nsensor: {type: ft}\n",
+                                       kDir / "lost.yaml");
     FAIL();
   } catch (const Error& e) {
     EXPECT_TRUE(contains(std::string(e.what()), "lost.yaml:1: robot: cannot load"));

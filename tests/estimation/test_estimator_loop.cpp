@@ -24,23 +24,23 @@ struct Scenario {
   double gain = 100.0;
   double param_error = 0.01;
   unsigned seed = 1;
-  int link = -1;            ///< contact link (−1: free motion)
+  int link = -1;  ///< contact link (−1: free motion)
   Vector3 p_L = Vector3::Zero();
   Vector3 F_L = Vector3::Zero();  ///< constant in the link frame
-  int link2 = -1;           ///< optional second contact
+  int link2 = -1;                 ///< optional second contact
   Vector3 p2_L = Vector3::Zero(), F2_L = Vector3::Zero();
   double t_on = 1.0, t_off = 2.5, t_end = 2.5;
-  bool force_in_world = false;  ///< F_L is then constant in the world frame
-  double speed = 1.0;           ///< scales the trajectory's frequencies
-  double tau_min = 1.0;         ///< detection threshold (default of DetectionOptions)
-  double kp = 100.0, kd = 20.0; ///< the tracking controller's PD gains [1/s², 1/s]
+  bool force_in_world = false;   ///< F_L is then constant in the world frame
+  double speed = 1.0;            ///< scales the trajectory's frequencies
+  double tau_min = 1.0;          ///< detection threshold (default of DetectionOptions)
+  double kp = 100.0, kd = 20.0;  ///< the tracking controller's PD gains [1/s², 1/s]
 };
 
 struct Sample {
   double t;
-  bool in_contact;           // truth
-  Vector3 F_true;            // world
-  Vector3 p_true;            // world
+  bool in_contact;  // truth
+  Vector3 F_true;   // world
+  Vector3 p_true;   // world
   ContactEstimate e;
 };
 
@@ -69,10 +69,13 @@ void run(const Scenario& s, Visit&& visit) {
     if (!on) return 0;
     const Vector3 F_W = s.force_in_world ? s.F_L : Vector3(d.X_WB[s.link].rotation * s.F_L);
     w[k++] = {s.link, F_W, d.X_WB[s.link].act(s.p_L), Vector3::Zero()};
-    if (s.link2 >= 0) w[k++] = {s.link2, d.X_WB[s.link2].rotation * s.F2_L, d.X_WB[s.link2].act(s.p2_L), Vector3::Zero()};
+    if (s.link2 >= 0)
+      w[k++] = {s.link2, d.X_WB[s.link2].rotation * s.F2_L, d.X_WB[s.link2].act(s.p2_L),
+                Vector3::Zero()};
     return k;
   };
-  arm.external = [&](const Model& m, Data& d, double, const VectorX& q, const VectorX& dq, VectorX& out) {
+  arm.external = [&](const Model& m, Data& d, double, const VectorX& q, const VectorX& dq,
+                     VectorX& out) {
     forward_kinematics(m, d, q);
     ExternalWrench w[2];
     const int k = wrenches(d, w);
@@ -104,8 +107,9 @@ void run(const Scenario& s, Visit&& visit) {
     const int nw = wrenches(truth, w);
     rnea(nominal, truth, arm.q, arm.dq, ddq, std::span<const ExternalWrench>(w, nw));
     const Vector6 reading = sensor_reading(truth, Pose{});
-    const Status st = s.sensor == SensorType::kNone ? est.update(arm.t, arm.q, arm.dq, tau)
-                                                    : est.update(arm.t, arm.q, arm.dq, tau, reading);
+    const Status st = s.sensor == SensorType::kNone
+                          ? est.update(arm.t, arm.q, arm.dq, tau)
+                          : est.update(arm.t, arm.q, arm.dq, tau, reading);
     ASSERT_TRUE(st.ok());
     Sample smp{arm.t, nw > 0, nw > 0 ? w[0].force_W : Vector3::Constant(kNaN),
                nw > 0 ? w[0].point_W : Vector3::Constant(kNaN), est.result()};
@@ -164,7 +168,8 @@ TEST(EstimatorLoop, ForceErrorDecaysLikeTheFirstOrderLawAndIsBelowOnePercentByEi
       std::printf("%s K = %.0f: error at 1/K %.3f, max after 8/K %.4f (relative)\n",
                   std::string(to_string(sensor)).c_str(), gain, err_first, worst_late);
       EXPECT_LE(worst_law_excess, 0.0) << to_string(sensor) << " K = " << gain;
-      EXPECT_GT(err_first, 0.2) << to_string(sensor) << " K = " << gain;  // ≈ e^{−1}: the law, not a lucky start
+      EXPECT_GT(err_first, 0.2) << to_string(sensor)
+                                << " K = " << gain;  // ≈ e^{−1}: the law, not a lucky start
       EXPECT_LT(worst_late, floor) << to_string(sensor) << " K = " << gain;
     }
   }
@@ -186,7 +191,8 @@ TEST(EstimatorLoop, NoFalseAlarmsOverSixtySecondsOfFreeMotionWithOnePercentParam
     });
     EXPECT_EQ(alarms, 0) << to_string(sensor);
     EXPECT_EQ(pending, 0) << to_string(sensor);
-    RecordProperty(std::string("max_residual_") + std::string(to_string(sensor)), std::to_string(max_residual));
+    RecordProperty(std::string("max_residual_") + std::string(to_string(sensor)),
+                   std::to_string(max_residual));
     std::printf("%s: max |r| = %.3f N m, max |F| = %.3f N over 60 s of free motion\n",
                 std::string(to_string(sensor)).c_str(), max_residual, max_force);
   }

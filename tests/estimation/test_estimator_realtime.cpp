@@ -58,7 +58,8 @@ std::vector<Config> all_configs() {
   std::vector<Config> out;
   for (SensorType s : {SensorType::kForceTorque, SensorType::kForce, SensorType::kNone}) {
     for (ContactModel c : {ContactModel::kPureForce, ContactModel::kKnownPoint}) {
-      for (AccelerationRoute r : {AccelerationRoute::kResidual, AccelerationRoute::kDifferentiation}) {
+      for (AccelerationRoute r :
+           {AccelerationRoute::kResidual, AccelerationRoute::kDifferentiation}) {
         out.push_back({s, c, r});
       }
     }
@@ -97,8 +98,9 @@ TEST(EstimatorRealTime, TenThousandUpdatesOfEveryConfigurationAllocateNothing) {
     test::AllocationCounter counter;
     for (int k = 1; k <= 10000; ++k) {
       const int i = k % 100;
-      const Status st = c.sensor == SensorType::kNone ? est.update(k * 1e-3, s.q[i], s.dq[i], s.tau[i])
-                                                      : est.update(k * 1e-3, s.q[i], s.dq[i], s.tau[i], s.reading[i]);
+      const Status st = c.sensor == SensorType::kNone
+                            ? est.update(k * 1e-3, s.q[i], s.dq[i], s.tau[i])
+                            : est.update(k * 1e-3, s.q[i], s.dq[i], s.tau[i], s.reading[i]);
       failures += st.ok() ? 0 : 1;
       seen |= est.result().flags;
     }
@@ -109,7 +111,8 @@ TEST(EstimatorRealTime, TenThousandUpdatesOfEveryConfigurationAllocateNothing) {
     EXPECT_TRUE(seen & EstimateFlag::kContact) << describe(c);
     if (c.contact == ContactModel::kPureForce) {
       EXPECT_TRUE(seen & EstimateFlag::kLineOfAction) << describe(c);
-      EXPECT_TRUE(seen & (EstimateFlag::kSurfacePoint | EstimateFlag::kSurfaceMissed)) << describe(c);
+      EXPECT_TRUE(seen & (EstimateFlag::kSurfacePoint | EstimateFlag::kSurfaceMissed))
+          << describe(c);
     } else {
       EXPECT_TRUE(seen & EstimateFlag::kMoment) << describe(c);
     }
@@ -120,10 +123,11 @@ bool same_bits(const ContactEstimate& a, const ContactEstimate& b) {
   auto eq = [](const auto& x, const auto& y) {
     return x.size() == y.size() && std::memcmp(x.data(), y.data(), sizeof(double) * x.size()) == 0;
   };
-  return a.contact == b.contact && a.link == b.link && a.flags == b.flags && a.status.code == b.status.code &&
-         eq(a.force_W, b.force_W) && eq(a.moment_W, b.moment_W) && eq(a.point_W, b.point_W) &&
-         eq(a.point_L, b.point_L) && eq(a.line_point_W, b.line_point_W) &&
-         eq(a.line_direction_W, b.line_direction_W) && eq(a.residual, b.residual) &&
+  return a.contact == b.contact && a.link == b.link && a.flags == b.flags &&
+         a.status.code == b.status.code && eq(a.force_W, b.force_W) && eq(a.moment_W, b.moment_W) &&
+         eq(a.point_W, b.point_W) && eq(a.point_L, b.point_L) &&
+         eq(a.line_point_W, b.line_point_W) && eq(a.line_direction_W, b.line_direction_W) &&
+         eq(a.residual, b.residual) &&
          std::memcmp(&a.condition_number, &b.condition_number, sizeof(double)) == 0 &&
          std::memcmp(&a.surface_distance, &b.surface_distance, sizeof(double)) == 0;
 }
@@ -189,7 +193,8 @@ TEST(EstimatorRealTime, NearASingularityTheEstimateStaysFiniteBoundedAndFlagged)
     const VectorX zero = VectorX::Zero(7);
     const Vector3 F(5, -12, 8);
     const Pose X = kdl.compute_body_pose(q, 6);
-    const auto ref = kdl.compute(q, zero, zero, 6, F, X.act(Vector3(0.0, 0.06, 0.0)), Vector3::Zero());
+    const auto ref =
+        kdl.compute(q, zero, zero, 6, F, X.act(Vector3(0.0, 0.06, 0.0)), Vector3::Zero());
     t += 1e-3;
     ASSERT_TRUE(est.update_with(t, q, zero, zero, ref.tau_ext, ref.tau, Vector6::Zero()).ok());
     const ContactEstimate& e = est.result();
@@ -207,7 +212,8 @@ TEST(EstimatorRealTime, NearASingularityTheEstimateStaysFiniteBoundedAndFlagged)
       EXPECT_LE((e.force_W - F).norm(), 1e-6 * F.norm());
     } else if (q4 <= 1e-4) {
       EXPECT_GT(e.condition_number, 1e3) << "q4 = " << q4;
-      EXPECT_TRUE(e.has(EstimateFlag::kIllConditioned) || e.has(EstimateFlag::kUnobservable)) << "q4 = " << q4;
+      EXPECT_TRUE(e.has(EstimateFlag::kIllConditioned) || e.has(EstimateFlag::kUnobservable))
+          << "q4 = " << q4;
     }
     if (q4 == 0.0) {
       EXPECT_TRUE(e.has(EstimateFlag::kUnobservable));
@@ -230,11 +236,14 @@ TEST(EstimatorRealTime, TareRemovesAConstantSensorBiasEstimatedAtRest) {
   VectorX q(7);
   q << 0.1, 0.8, 0.2, -1.1, 0.3, 0.5, 0.0;
   const VectorX zero = VectorX::Zero(7);
-  const auto free = kdl.compute(q, zero, zero, 4, Vector3::Zero(), Vector3::Zero(), Vector3::Zero());
+  const auto free =
+      kdl.compute(q, zero, zero, 4, Vector3::Zero(), Vector3::Zero(), Vector3::Zero());
   ContactEstimator est(model, {}, o);
   ASSERT_TRUE(est.reset(0.0, q, zero, free.tau).ok());
   for (int k = 1; k <= 50; ++k) {
-    ASSERT_TRUE(est.update(k * 1e-3, q, zero, free.tau, test::to_sensor_frame(free.reading_W, Pose{}) + bias).ok());
+    ASSERT_TRUE(est.update(k * 1e-3, q, zero, free.tau,
+                           test::to_sensor_frame(free.reading_W, Pose{}) + bias)
+                    .ok());
     EXPECT_EQ(est.result().has(EstimateFlag::kTaring), k < 50);
     EXPECT_FALSE(est.result().contact);
   }
@@ -243,7 +252,9 @@ TEST(EstimatorRealTime, TareRemovesAConstantSensorBiasEstimatedAtRest) {
   const Pose X = kdl.compute_body_pose(q, 4);
   const Vector3 F(8, 3, -6), M(0.3, 0.1, -0.2);
   const auto touched = kdl.compute(q, zero, zero, 4, F, X.act(o.contact.point), M);
-  ASSERT_TRUE(est.update(0.051, q, zero, free.tau, test::to_sensor_frame(touched.reading_W, Pose{}) + bias).ok());
+  ASSERT_TRUE(
+      est.update(0.051, q, zero, free.tau, test::to_sensor_frame(touched.reading_W, Pose{}) + bias)
+          .ok());
   EXPECT_LE((est.result().force_W - F).norm(), 1e-6 * F.norm());
   EXPECT_LE((est.result().moment_W - M).norm(), 1e-6);
   EXPECT_TRUE(est.result().contact);
@@ -266,7 +277,9 @@ TEST(EstimatorRealTime, ALineOfActionThatMissesTheLinkReportsTheNearestSurfacePo
   const Vector3 p_W = X.act(Vector3(0.3, 0.0, 0.2));
   const Vector3 F = X.rotation * Vector3(0, 10, 0);
   const auto ref = kdl.compute(q, zero, zero, 5, F, p_W, Vector3::Zero());
-  ASSERT_TRUE(est.update_with(0.0, q, zero, zero, ref.tau_ext, ref.tau, test::to_sensor_frame(ref.reading_W, Pose{})).ok());
+  ASSERT_TRUE(est.update_with(0.0, q, zero, zero, ref.tau_ext, ref.tau,
+                              test::to_sensor_frame(ref.reading_W, Pose{}))
+                  .ok());
   const ContactEstimate& e = est.result();
   ASSERT_EQ(e.link, 5);
   EXPECT_TRUE(e.has(EstimateFlag::kLineOfAction));

@@ -17,12 +17,14 @@ namespace {
 
 using test::SeededRng;
 
-const std::filesystem::path kUrdf = std::filesystem::path(EXTWRENCH_SHARED_DIR) /
-                                    "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
+const std::filesystem::path kUrdf =
+    std::filesystem::path(EXTWRENCH_SHARED_DIR) /
+    "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
 
 /// Replaces every occurrence of `from` (plain text; <regex> trips a false GCC 12 warning at -O1).
 std::string replace_all(std::string text, const std::string& from, const std::string& to) {
-  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+  for (std::size_t at = text.find(from); at != std::string::npos;
+       at = text.find(from, at + to.size())) {
     text.replace(at, from.size(), to);
   }
   return text;
@@ -30,7 +32,8 @@ std::string replace_all(std::string text, const std::string& from, const std::st
 
 /// Removes every self-closing element `<tag .../>`.
 std::string remove_elements(std::string text, const std::string& tag) {
-  for (std::size_t at = text.find("<" + tag); at != std::string::npos; at = text.find("<" + tag, at)) {
+  for (std::size_t at = text.find("<" + tag); at != std::string::npos;
+       at = text.find("<" + tag, at)) {
     text.erase(at, text.find("/>", at) + 2 - at);
   }
   return text;
@@ -69,12 +72,15 @@ TEST(PandaMeshContact, PushingPointIsNeverConfusedWithThePullingOne) {
     const auto& shapes = robot.geometry.body_shapes[link];
     if (shapes.empty()) continue;
     for (int k = 0; k < 100; ++k) {
-      const CollisionShape& shape = robot.geometry.shapes[shapes[static_cast<std::size_t>(rng.uniform(0, shapes.size() - 1e-9))]];
+      const CollisionShape& shape =
+          robot.geometry
+              .shapes[shapes[static_cast<std::size_t>(rng.uniform(0, shapes.size() - 1e-9))]];
       if (shape.type != ShapeType::kMesh || !shape.mesh) continue;
       const TriangleMesh& mesh = *shape.mesh;
       // A random point of a random triangle (area-agnostic), its outward normal (winding).
       const int tri = static_cast<int>(rng.uniform(0, mesh.triangles.cols() - 1e-9));
-      const Vector3 a = mesh.vertices.col(mesh.triangles(0, tri)), b = mesh.vertices.col(mesh.triangles(1, tri)),
+      const Vector3 a = mesh.vertices.col(mesh.triangles(0, tri)),
+                    b = mesh.vertices.col(mesh.triangles(1, tri)),
                     c = mesh.vertices.col(mesh.triangles(2, tri));
       const Vector3 cross = (b - a).cross(c - a);
       if (cross.norm() < 1e-10) continue;  // degenerate triangle
@@ -94,7 +100,9 @@ TEST(PandaMeshContact, PushingPointIsNeverConfusedWithThePullingOne) {
       const Vector3 F = 15.0 * dir;  // pushes into the surface at p
       const auto ref = kdl.compute(q, zero, zero, link, F, p_W, Vector3::Zero());
       t += 1e-3;
-      ASSERT_TRUE(est.update_with(t, q, zero, zero, ref.tau_ext, ref.tau, test::to_sensor_frame(ref.reading_W, Pose{})).ok());
+      ASSERT_TRUE(est.update_with(t, q, zero, zero, ref.tau_ext, ref.tau,
+                                  test::to_sensor_frame(ref.reading_W, Pose{}))
+                      .ok());
       const ContactEstimate& e = est.result();
       ASSERT_EQ(e.link, link);
       ASSERT_TRUE(e.has(EstimateFlag::kLineOfAction));
@@ -139,7 +147,9 @@ TEST(PandaMeshContact, ALineThatMissesTheLinkReportsTheNearestSurfacePoint) {
   const Vector3 offset = X.rotation * Vector3(0.6, 0.0, 0.0);
   const Vector3 F = X.rotation * Vector3(0.0, 12.0, 0.0);
   const auto ref = kdl.compute(q, zero, zero, 4, F, X.translation + offset, Vector3::Zero());
-  ASSERT_TRUE(est.update_with(0.0, q, zero, zero, ref.tau_ext, ref.tau, test::to_sensor_frame(ref.reading_W, Pose{})).ok());
+  ASSERT_TRUE(est.update_with(0.0, q, zero, zero, ref.tau_ext, ref.tau,
+                              test::to_sensor_frame(ref.reading_W, Pose{}))
+                  .ok());
   const ContactEstimate& e = est.result();
   ASSERT_EQ(e.link, 4);
   EXPECT_TRUE(e.has(EstimateFlag::kSurfaceMissed));

@@ -34,9 +34,12 @@ inline Model paper_arm_model() {
   const double alpha[7] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0};
   const double d[7] = {0, 0, 0.40, 0, 0.39, 0, 0.078};
   const double mass[7] = {2.7, 2.7, 2.7, 2.7, 2.7, 1.7, 0.3};
-  const double com_cm[7][3] = {{0.1340, -8.7777, 2.6220}, {0.1340, 2.6220, 8.7777},
-                               {0.1340, 8.7777, 2.6220},  {0.1340, 2.6220, 8.7777},
-                               {0.1340, -8.7777, 2.6220}, {0, 0.5, 0},
+  const double com_cm[7][3] = {{0.1340, -8.7777, 2.6220},
+                               {0.1340, 2.6220, 8.7777},
+                               {0.1340, 8.7777, 2.6220},
+                               {0.1340, 2.6220, 8.7777},
+                               {0.1340, -8.7777, 2.6220},
+                               {0, 0.5, 0},
                                {0, 0, -2.0}};
   // Ixx Ixy Ixz Iyy Iyz Izz [g m^2]
   const double in[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
@@ -114,8 +117,8 @@ inline GeometryModel chain_capsules(const Model& model, double radius = 0.05) {
   GeometryModel g;
   g.body_shapes.resize(static_cast<std::size_t>(model.num_bodies()));
   for (int b = 0; b < model.num_bodies(); ++b) {
-    const Vector3 end = b + 1 < model.num_bodies() ? model.joints[b + 1].placement.translation
-                                                   : Vector3(0.1, 0, 0);
+    const Vector3 end =
+        b + 1 < model.num_bodies() ? model.joints[b + 1].placement.translation : Vector3(0.1, 0, 0);
     CollisionShape s;
     s.type = ShapeType::kCapsule;
     s.body = b;
@@ -124,7 +127,8 @@ inline GeometryModel chain_capsules(const Model& model, double radius = 0.05) {
     s.length = std::max(end.norm(), 1e-3);
     // Capsule axis = shape z: rotate z onto `end`.
     const Vector3 z = end.norm() > 1e-9 ? Vector3(end.normalized()) : Vector3::UnitZ();
-    s.placement.rotation = Eigen::Quaterniond::FromTwoVectors(Vector3::UnitZ(), z).toRotationMatrix();
+    s.placement.rotation =
+        Eigen::Quaterniond::FromTwoVectors(Vector3::UnitZ(), z).toRotationMatrix();
     s.placement.translation = 0.5 * end;
     g.body_shapes[b].push_back(static_cast<int>(g.shapes.size()));
     g.shapes.push_back(s);
@@ -174,7 +178,8 @@ inline std::string model_to_urdf(const Model& model) {
       << "\"/><origin xyz=\"" << vec(j.placement.translation) << "\" rpy=\""
       << vec(rpy_from_rotation(j.placement.rotation)) << "\"/><axis xyz=\"" << vec(j.axis)
       << "\"/>";
-    if (j.type == JointType::kPrismatic) o << "<limit lower=\"-10\" upper=\"10\" effort=\"1000\" velocity=\"10\"/>";
+    if (j.type == JointType::kPrismatic)
+      o << "<limit lower=\"-10\" upper=\"10\" effort=\"1000\" velocity=\"10\"/>";
     o << "</joint>\n";
   }
   o << "</robot>\n";
@@ -256,9 +261,9 @@ class SimulatedArm {
 
 /// τ_ext = Jᵀ W of a force F_W applied at a point fixed in body `body` (p_B in body frame) plus a
 /// pure moment, from our RNEA with and without the wrench.
-inline void add_body_force_torque(const Model& model, Data& data, const VectorX& q, const VectorX& dq,
-                                  int body, const Vector3& p_B, const Vector3& F_W,
-                                  const Vector3& M_W, VectorX& tau_ext) {
+inline void add_body_force_torque(const Model& model, Data& data, const VectorX& q,
+                                  const VectorX& dq, int body, const Vector3& p_B,
+                                  const Vector3& F_W, const Vector3& M_W, VectorX& tau_ext) {
   const VectorX zero = VectorX::Zero(model.nq());
   forward_kinematics(model, data, q);
   ExternalWrench w;

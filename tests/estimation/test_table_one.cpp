@@ -47,7 +47,8 @@ struct Case {
 
 std::string case_name(const ::testing::TestParamInfo<Case>& info) {
   return std::string(info.param.robot == 0 ? "PaperArm" : "RandomChain") + "_" +
-         std::string(to_string(info.param.sensor)) + "_" + std::string(to_string(info.param.contact));
+         std::string(to_string(info.param.sensor)) + "_" +
+         std::string(to_string(info.param.contact));
 }
 
 // Table I for a 7R arm in general position (ranks are generic for random configurations).
@@ -72,7 +73,8 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
   for (int link = first_link; link <= n; ++link) {
     EstimatorOptions opt;
     opt.sensor.type = c.sensor;
-    opt.sensor.pose = Pose::from_xyz_rpy(rng.uniform_vector3(-0.2, 0.2), rng.uniform_vector3(-1, 1));
+    opt.sensor.pose =
+        Pose::from_xyz_rpy(rng.uniform_vector3(-0.2, 0.2), rng.uniform_vector3(-1, 1));
     opt.contact.model = c.contact;
     opt.contact.link = link;
     // Isolation of exact data: KDL's torques beyond the contact link are exactly zero.
@@ -99,7 +101,8 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
       if (dir.dot(normal_W) > 0) dir = -dir;
       if (dir.dot(normal_W) > -0.3) dir = (dir - normal_W).normalized();
       const Vector3 F = rng.uniform(5, 50) * dir;
-      const Vector3 M = c.contact == ContactModel::kKnownPoint ? rng.uniform_vector3(-2, 2) : Vector3::Zero();
+      const Vector3 M =
+          c.contact == ContactModel::kKnownPoint ? rng.uniform_vector3(-2, 2) : Vector3::Zero();
       const test::KdlReference::Result ref = kdl.compute(q, dq, ddq, link, F, p_W, M);
       const Vector6 reading_S = test::to_sensor_frame(ref.reading_W, opt.sensor.pose);
 
@@ -110,7 +113,8 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
         ContactEstimator est2(model, robot.geometry, o2);
         ASSERT_TRUE(est2.update_with(t, q, dq, ddq, ref.tau_ext, ref.tau, reading_S).ok());
         const ContactEstimate& e = est2.result();
-        if (moment_or_point_expected(c.sensor, link) && e.condition_number > kMaxCondition) continue;
+        if (moment_or_point_expected(c.sensor, link) && e.condition_number > kMaxCondition)
+          continue;
         ++accepted;
         ASSERT_TRUE(e.contact);
         EXPECT_TRUE(e.has(EstimateFlag::kKnownPoint));
@@ -125,7 +129,8 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
         }
         if (moment_or_point_expected(c.sensor, link)) {
           ASSERT_TRUE(e.has(EstimateFlag::kMoment)) << "link " << link;
-          EXPECT_LE((e.moment_W - M).norm(), kRelativeTol * std::max(M.norm(), 1.0)) << "link " << link;
+          EXPECT_LE((e.moment_W - M).norm(), kRelativeTol * std::max(M.norm(), 1.0))
+              << "link " << link;
           EXPECT_FALSE(e.has(EstimateFlag::kUnobservable));
         } else {
           EXPECT_FALSE(e.has(EstimateFlag::kMoment)) << "link " << link;
@@ -172,7 +177,8 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
         EXPECT_TRUE(e.point_W.array().isNaN().all());
       }
     }
-    EXPECT_EQ(accepted, kConfigurationsPerLink) << "link " << link << ": too many ill-conditioned samples";
+    EXPECT_EQ(accepted, kConfigurationsPerLink)
+        << "link " << link << ": too many ill-conditioned samples";
   }
 }
 
@@ -210,8 +216,11 @@ TEST(TableOneObservability, ForceSensorMomentOnLinkThreeDependsOnTheRankNotTheIn
     q << 0.3, q2, -0.4, 1.0, 0.2, 0.5, 0.1;
     const VectorX dq = VectorX::Zero(7), ddq = VectorX::Zero(7);
     const Pose X = kdl.compute_body_pose(q, 3);
-    const auto ref = kdl.compute(q, dq, ddq, 3, Vector3(3, -4, 5), X.act(opt.contact.point), Vector3(0.5, 0.2, -0.3));
-    ASSERT_TRUE(est.update_with(0.0, q, dq, ddq, ref.tau_ext, ref.tau, test::to_sensor_frame(ref.reading_W, Pose{})).ok());
+    const auto ref = kdl.compute(q, dq, ddq, 3, Vector3(3, -4, 5), X.act(opt.contact.point),
+                                 Vector3(0.5, 0.2, -0.3));
+    ASSERT_TRUE(est.update_with(0.0, q, dq, ddq, ref.tau_ext, ref.tau,
+                                test::to_sensor_frame(ref.reading_W, Pose{}))
+                    .ok());
     const ContactEstimate& e = est.result();
     EXPECT_TRUE(e.has(EstimateFlag::kForce));
     if (q2 == 0.0) {

@@ -2,12 +2,11 @@
 // products written directly from the textbook formulas (4x4 homogeneous transforms).
 #pragma once
 
+#include <Eigen/Geometry>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
 
 #include "extwrench/model/model.hpp"
 
@@ -63,11 +62,16 @@ inline Eigen::Isometry3d dh_modified(double a, double alpha, double d, double th
 }
 
 inline bool near(const Pose& x, const Eigen::Isometry3d& t, double tol) {
-  return (x.rotation - t.linear()).cwiseAbs().maxCoeff() < tol && (x.translation - t.translation()).norm() < tol;
+  return (x.rotation - t.linear()).cwiseAbs().maxCoeff() < tol &&
+         (x.translation - t.translation()).norm() < tol;
 }
 
-inline std::filesystem::path shared_models() { return std::filesystem::path(EXTWRENCH_SHARED_DIR) / "models"; }
+inline std::filesystem::path shared_models() {
+  return std::filesystem::path(EXTWRENCH_SHARED_DIR) / "models";
+}
 inline bool have_shared() { return std::filesystem::is_directory(shared_models()); }
-inline std::filesystem::path project_models() { return std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models"; }
+inline std::filesystem::path project_models() {
+  return std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models";
+}
 
 }  // namespace extwrench::test

@@ -15,7 +15,8 @@ namespace fs = std::filesystem;
 constexpr double kPi = std::numbers::pi;
 
 fs::path write_temp(const std::string& name, const std::string& text) {
-  const fs::path p = fs::temp_directory_path() / ("extwrench_" + std::to_string(::getpid()) + "_" + name);
+  const fs::path p =
+      fs::temp_directory_path() / ("extwrench_" + std::to_string(::getpid()) + "_" + name);
   std::ofstream(p) << text;
   return p;
 }
@@ -26,21 +27,27 @@ struct Row {
 };
 
 // A 4-joint arm with a != 0, offsets, a prismatic joint: exercises every branch.
-const Row kRows[4] = {{false, 0.0, kPi / 2, 0.30, 0.1}, {false, 0.40, 0.0, 0.0, -0.2}, {true, 0.05, -kPi / 2, 0.10, 0.3},
+const Row kRows[4] = {{false, 0.0, kPi / 2, 0.30, 0.1},
+                      {false, 0.40, 0.0, 0.0, -0.2},
+                      {true, 0.05, -kPi / 2, 0.10, 0.3},
                       {false, 0.0, kPi / 3, 0.12, 0.0}};
 
 std::string table(const std::string& convention) {
   std::string y = "name: t\nconvention: " + convention + "\ngravity: [0, 0, -1.62]\n";
-  y += "base: {name: root, mass: 1.0, com: [0, 0, 0.1], inertia: [0.01, 0, 0, 0.01, 0, 0.01]}\njoints:\n";
+  y += "base: {name: root, mass: 1.0, com: [0, 0, 0.1], inertia: [0.01, 0, 0, 0.01, 0, "
+       "0.01]}\njoints:\n";
   for (int i = 0; i < 4; ++i) {
     const Row& r = kRows[i];
     char buf[512];
     std::snprintf(buf, sizeof buf,
-                  "  - name: j%d\n    type: %s\n    a: %.17g\n    alpha: %.17g\n    d: %.17g\n    theta: %.17g\n"
+                  "  - name: j%d\n    type: %s\n    a: %.17g\n    alpha: %.17g\n    d: %.17g\n    "
+                  "theta: %.17g\n"
                   "    link:\n      name: l%d\n      mass: %.3g\n      com: [0.02, -0.03, 0.05]\n"
                   "      inertia: [[0.02, 0.001, 0], [0.001, 0.03, 0.002], [0, 0.002, 0.025]]\n"
-                  "      collision:\n        - {type: box, size: [0.1, 0.1, 0.2], xyz: [0.01, 0.02, 0.03], rpy: [0.1, 0.2, 0.3]}\n",
-                  i + 1, r.prismatic ? "prismatic" : "revolute", r.a, r.alpha, r.d, r.theta, i + 1, 1.0 + i);
+                  "      collision:\n        - {type: box, size: [0.1, 0.1, 0.2], xyz: [0.01, "
+                  "0.02, 0.03], rpy: [0.1, 0.2, 0.3]}\n",
+                  i + 1, r.prismatic ? "prismatic" : "revolute", r.a, r.alpha, r.d, r.theta, i + 1,
+                  1.0 + i);
     y += buf;
   }
   return y;
@@ -75,15 +82,21 @@ void check_against_direct_dh(const std::string& convention) {
       // Mass properties were given in the DH frame: the world CoM must agree.
       const Inertia& in = m.bodies[static_cast<std::size_t>(i)].inertia;
       const Vector3 com_W = X[static_cast<std::size_t>(i)].act(in.com);
-      EXPECT_LT((com_W - T * Eigen::Vector3d(0.02, -0.03, 0.05)).norm(), 1e-12) << convention << " link " << i;
+      EXPECT_LT((com_W - T * Eigen::Vector3d(0.02, -0.03, 0.05)).norm(), 1e-12)
+          << convention << " link " << i;
       Matrix3 I_dh;
       I_dh << 0.02, 0.001, 0, 0.001, 0.03, 0.002, 0, 0.002, 0.025;
-      const Matrix3 I_W = X[static_cast<std::size_t>(i)].rotation * in.inertia_com * X[static_cast<std::size_t>(i)].rotation.transpose();
+      const Matrix3 I_W = X[static_cast<std::size_t>(i)].rotation * in.inertia_com *
+                          X[static_cast<std::size_t>(i)].rotation.transpose();
       EXPECT_LT((I_W - T.linear() * I_dh * T.linear().transpose()).cwiseAbs().maxCoeff(), 1e-12);
       // Collision shapes too.
-      const CollisionShape& s = r.geometry.shapes[static_cast<std::size_t>(r.geometry.body_shapes[static_cast<std::size_t>(i)][0])];
+      const CollisionShape& s = r.geometry.shapes[static_cast<std::size_t>(
+          r.geometry.body_shapes[static_cast<std::size_t>(i)][0])];
       const Pose X_shape = X[static_cast<std::size_t>(i)] * s.placement;
-      EXPECT_TRUE(test::near(X_shape, T * test::iso(Pose::from_xyz_rpy(Vector3(0.01, 0.02, 0.03), Vector3(0.1, 0.2, 0.3))), 1e-12));
+      EXPECT_TRUE(test::near(
+          X_shape,
+          T * test::iso(Pose::from_xyz_rpy(Vector3(0.01, 0.02, 0.03), Vector3(0.1, 0.2, 0.3))),
+          1e-12));
     }
   }
 }

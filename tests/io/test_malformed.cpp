@@ -22,57 +22,82 @@ struct Expected {
 const std::map<std::string, Expected>& cases() {
   static const std::map<std::string, Expected> kCases = {
       // ---- URDF
-      {"mass_not_a_number.urdf", {11, {"<mass> of link 'arm'", "attribute 'value'", "expected a number, got 'abc'"}}},
-      {"mass_trailing_garbage.urdf", {11, {"<mass> of link 'arm'", "attribute 'value'", "got '1.0x'"}}},
-      {"mass_empty.urdf", {11, {"<mass> of link 'arm'", "attribute 'value': expected a number, got ''"}}},
+      {"mass_not_a_number.urdf",
+       {11, {"<mass> of link 'arm'", "attribute 'value'", "expected a number, got 'abc'"}}},
+      {"mass_trailing_garbage.urdf",
+       {11, {"<mass> of link 'arm'", "attribute 'value'", "got '1.0x'"}}},
+      {"mass_empty.urdf",
+       {11, {"<mass> of link 'arm'", "attribute 'value': expected a number, got ''"}}},
       {"mass_missing_value.urdf", {11, {"<mass> of link 'arm'", "attribute 'value': missing"}}},
-      {"mass_negative.urdf", {11, {"<mass> of link 'arm'", "attribute 'value': must not be negative, got '-1'"}}},
-      {"inertia_not_a_number.urdf", {12, {"<inertia> of link 'arm'", "attribute 'ixx'", "got 'abc'"}}},
+      {"mass_negative.urdf",
+       {11, {"<mass> of link 'arm'", "attribute 'value': must not be negative, got '-1'"}}},
+      {"inertia_not_a_number.urdf",
+       {12, {"<inertia> of link 'arm'", "attribute 'ixx'", "got 'abc'"}}},
       {"inertia_missing_iyz.urdf", {12, {"<inertia> of link 'arm'", "attribute 'iyz': missing"}}},
       {"inertia_not_psd.urdf", {12, {"link 'arm'", "inertia: not positive semi-definite"}}},
-      {"inertia_triangle.urdf", {12, {"link 'arm'", "inertia: principal moments violate the triangle inequality"}}},
+      {"inertia_triangle.urdf",
+       {12, {"link 'arm'", "inertia: principal moments violate the triangle inequality"}}},
       {"inertia_nan.urdf", {12, {"<inertia> of link 'arm'", "attribute 'ixx'", "got 'nan'"}}},
-      {"inertial_missing_inertia.urdf", {9, {"<inertial> of link 'arm'", "missing element <inertia>"}}},
-      {"origin_two_numbers.urdf", {10, {"<origin> of link 'arm'", "attribute 'xyz'", "expected 3 numbers, got '0 0'"}}},
-      {"joint_origin_bad_rpy.urdf", {19, {"<origin> of joint 'j1'", "attribute 'rpy'", "got '0 0 x'"}}},
+      {"inertial_missing_inertia.urdf",
+       {9, {"<inertial> of link 'arm'", "missing element <inertia>"}}},
+      {"origin_two_numbers.urdf",
+       {10, {"<origin> of link 'arm'", "attribute 'xyz'", "expected 3 numbers, got '0 0'"}}},
+      {"joint_origin_bad_rpy.urdf",
+       {19, {"<origin> of joint 'j1'", "attribute 'rpy'", "got '0 0 x'"}}},
       {"axis_zero.urdf", {20, {"<axis> of joint 'j1'", "attribute 'xyz'", "must not be zero"}}},
-      {"limit_lower_above_upper.urdf", {21, {"<limit> of joint 'j1'", "'lower' > 'upper'", "'2' > '1'"}}},
+      {"limit_lower_above_upper.urdf",
+       {21, {"<limit> of joint 'j1'", "'lower' > 'upper'", "'2' > '1'"}}},
       {"limit_missing.urdf", {16, {"<joint> of joint 'j1'", "missing element <limit>"}}},
       {"limit_missing_effort.urdf", {21, {"<limit> of joint 'j1'", "attribute 'effort': missing"}}},
-      {"limit_negative_velocity.urdf", {21, {"<limit> of joint 'j1'", "attribute 'velocity': must not be negative"}}},
-      {"joint_type_unknown.urdf", {16, {"joint 'j1'", "attribute 'type'", "unknown joint type 'ball'"}}},
-      {"joint_type_floating.urdf", {16, {"joint 'j1'", "attribute 'type'", "unsupported joint type 'floating'"}}},
+      {"limit_negative_velocity.urdf",
+       {21, {"<limit> of joint 'j1'", "attribute 'velocity': must not be negative"}}},
+      {"joint_type_unknown.urdf",
+       {16, {"joint 'j1'", "attribute 'type'", "unknown joint type 'ball'"}}},
+      {"joint_type_floating.urdf",
+       {16, {"joint 'j1'", "attribute 'type'", "unsupported joint type 'floating'"}}},
       {"joint_parent_unknown.urdf", {16, {"joint 'j1'", "parent: no link named 'nope'"}}},
       {"joint_child_missing.urdf", {16, {"joint 'j1'", "missing element <child>"}}},
       {"link_duplicate.urdf", {8, {"link 'base'", "duplicate link name"}}},
-      {"link_two_parents.urdf", {23, {"joint 'j2'", "child: link 'arm' already has a parent joint 'j1'"}}},
+      {"link_two_parents.urdf",
+       {23, {"joint 'j2'", "child: link 'arm' already has a parent joint 'j1'"}}},
       {"joint_cycle.urdf", {23, {"joint 'j2'", "closes a cycle of links"}}},
       {"link_two_roots.urdf", {23, {"link 'island'", "more than one root link"}}},
       {"geometry_unknown.urdf", {14, {"<cone> of link 'arm'", "unknown geometry <cone>"}}},
-      {"sphere_negative_radius.urdf", {14, {"<sphere> of link 'arm'", "attribute 'radius': must be positive, got '-0.05'"}}},
-      {"capsule_missing_length.urdf", {14, {"<capsule> of link 'arm'", "attribute 'length': missing"}}},
-      {"mesh_missing_filename.urdf", {14, {"<mesh> of link 'arm'", "attribute 'filename': missing"}}},
-      {"mesh_file_not_found.urdf", {14, {"<mesh> of link 'arm'", "attribute 'filename'", "does_not_exist.stl", "not found"}}},
+      {"sphere_negative_radius.urdf",
+       {14, {"<sphere> of link 'arm'", "attribute 'radius': must be positive, got '-0.05'"}}},
+      {"capsule_missing_length.urdf",
+       {14, {"<capsule> of link 'arm'", "attribute 'length': missing"}}},
+      {"mesh_missing_filename.urdf",
+       {14, {"<mesh> of link 'arm'", "attribute 'filename': missing"}}},
+      {"mesh_file_not_found.urdf",
+       {14, {"<mesh> of link 'arm'", "attribute 'filename'", "does_not_exist.stl", "not found"}}},
       {"link_missing_name.urdf", {8, {"<link>", "attribute 'name': missing"}}},
       {"not_well_formed.urdf", {2, {"not well-formed XML"}}},
       {"root_not_robot.urdf", {2, {"the root element must be <robot>, got <model>"}}},
-      {"massless_leaf.urdf", {11, {"joint 'j1'", "link 'arm'", "mass matrix is not positive definite"}}},
+      {"massless_leaf.urdf",
+       {11, {"joint 'j1'", "link 'arm'", "mass matrix is not positive definite"}}},
       // ---- DH YAML
       {"convention_missing.yaml", {1, {"key 'convention': missing"}}},
-      {"convention_unknown.yaml", {2, {"key 'convention'", "expected 'standard' or 'modified', got 'dh'"}}},
-      {"alpha_not_a_number.yaml", {11, {"key 'joints[0].alpha'", "expected a number", "got 'abc'"}}},
+      {"convention_unknown.yaml",
+       {2, {"key 'convention'", "expected 'standard' or 'modified', got 'dh'"}}},
+      {"alpha_not_a_number.yaml",
+       {11, {"key 'joints[0].alpha'", "expected a number", "got 'abc'"}}},
       {"d_missing.yaml", {8, {"key 'joints[0].d': missing"}}},
       {"mass_not_a_number.yaml", {16, {"key 'joints[0].link.mass'", "got 'heavy'"}}},
       {"mass_negative.yaml", {16, {"key 'joints[0].link.mass'", "must not be negative, got '-2'"}}},
       {"inertia_five_entries.yaml", {18, {"key 'joints[0].link.inertia'", "expected 6 numbers"}}},
-      {"inertia_not_psd.yaml", {18, {"key 'joints[0].link.inertia'", "link 'l1'", "not positive semi-definite"}}},
-      {"inertia_not_symmetric.yaml", {18, {"key 'joints[0].link.inertia'", "link 'l1'", "not symmetric"}}},
+      {"inertia_not_psd.yaml",
+       {18, {"key 'joints[0].link.inertia'", "link 'l1'", "not positive semi-definite"}}},
+      {"inertia_not_symmetric.yaml",
+       {18, {"key 'joints[0].link.inertia'", "link 'l1'", "not symmetric"}}},
       {"com_two_numbers.yaml", {17, {"key 'joints[0].link.com'", "expected a list of 3 numbers"}}},
       {"unknown_key.yaml", {12, {"key 'joints[0].dd'", "unknown key"}}},
       {"joint_type_unknown.yaml", {9, {"key 'joints[0].type'", "got 'spherical'"}}},
       {"lower_above_upper.yaml", {14, {"key 'joints[0].lower'", "lower > upper"}}},
-      {"shape_unknown.yaml", {20, {"key 'joints[0].link.collision[0].type'", "unknown shape 'cone'"}}},
-      {"radius_negative.yaml", {20, {"key 'joints[0].link.collision[0].radius'", "must be positive"}}},
+      {"shape_unknown.yaml",
+       {20, {"key 'joints[0].link.collision[0].type'", "unknown shape 'cone'"}}},
+      {"radius_negative.yaml",
+       {20, {"key 'joints[0].link.collision[0].radius'", "must be positive"}}},
       {"link_missing.yaml", {8, {"key 'joints[0].link': missing"}}},
       {"link_duplicate_name.yaml", {15, {"link 'link0'", "duplicate link name"}}},
       {"frame_unknown_link.yaml", {22, {"key 'frames[0].link'", "no link named 'nope'"}}},
@@ -88,7 +113,8 @@ fs::path malformed_dir() { return fs::path(EXTWRENCH_TEST_DATA_DIR) / "malformed
 TEST(MalformedFiles, EveryFileIsInTheTableAndThereAreEnough) {
   int n = 0;
   for (const auto& e : fs::directory_iterator(malformed_dir())) {
-    EXPECT_TRUE(cases().count(e.path().filename().string())) << e.path().filename() << " has no expectation";
+    EXPECT_TRUE(cases().count(e.path().filename().string()))
+        << e.path().filename() << " has no expectation";
     ++n;
   }
   EXPECT_GE(n, 30);
@@ -109,7 +135,8 @@ TEST(MalformedFiles, AreRejectedNamingFileLineElementAndField) {
     }
     ASSERT_FALSE(msg.empty()) << file << " was accepted";
     const std::string where = path.string() + ":" + std::to_string(expected.line) + ":";
-    EXPECT_EQ(msg.rfind(where, 0), 0u) << file << ": expected to start with '" << where << "', got: " << msg;
+    EXPECT_EQ(msg.rfind(where, 0), 0u)
+        << file << ": expected to start with '" << where << "', got: " << msg;
     for (const std::string& f : expected.fragments) {
       EXPECT_NE(msg.find(f), std::string::npos) << file << ": expected '" << f << "' in: " << msg;
     }

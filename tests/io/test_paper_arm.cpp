@@ -18,13 +18,20 @@ constexpr double kPi = std::numbers::pi;
 const double kAlpha[7] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0.0};
 const double kD[7] = {0, 0, 0.40, 0, 0.39, 0, 0.078};
 const double kMass[7] = {2.7, 2.7, 2.7, 2.7, 2.7, 1.7, 0.3};
-const double kComCm[7][3] = {{0.1340, -8.7777, 2.6220}, {0.1340, 2.6220, 8.7777}, {0.1340, 8.7777, 2.6220},
-                             {0.1340, 2.6220, 8.7777},  {0.1340, -8.7777, 2.6220}, {0, 0.5, 0},
+const double kComCm[7][3] = {{0.1340, -8.7777, 2.6220},
+                             {0.1340, 2.6220, 8.7777},
+                             {0.1340, 8.7777, 2.6220},
+                             {0.1340, 2.6220, 8.7777},
+                             {0.1340, -8.7777, 2.6220},
+                             {0, 0.5, 0},
                              {0, 0, -2.0}};
 // I_xx I_xy I_xz I_yy I_yz I_zz in g m^2
-const double kInertiaGm2[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173}, {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                                  {16.341, 0.003, 0.001, 5.026, 3.533, 16.173},  {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                                  {16.341, 0.003, 0.001, 5.026, -3.533, 16.173}, {5.0, 0, 0, 3.6, 0, 4.7},
+const double kInertiaGm2[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
+                                  {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
+                                  {16.341, 0.003, 0.001, 5.026, 3.533, 16.173},
+                                  {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
+                                  {16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
+                                  {5.0, 0, 0, 3.6, 0, 4.7},
                                   {1.0, 0, 0, 1.0, 0, 1.0}};
 
 RobotDescription load(const char* file) {
@@ -57,8 +64,10 @@ TEST(PaperArm, LinkFramesAreTheDhFramesOfTheSpecAtRandomConfigurations) {
     for (int i = 0; i <= 7; ++i) {
       if (i > 0) T = T * test::dh_standard(0.0, kAlpha[i - 1], kD[i - 1], q[i - 1]);
       const std::string name = "link" + std::to_string(i);
-      EXPECT_TRUE(test::near(test::world_frame_pose(yaml.model, Xy, name), T, 1e-12)) << "yaml " << name;
-      EXPECT_TRUE(test::near(test::world_frame_pose(urdf.model, Xu, name), T, 1e-12)) << "urdf " << name;
+      EXPECT_TRUE(test::near(test::world_frame_pose(yaml.model, Xy, name), T, 1e-12))
+          << "yaml " << name;
+      EXPECT_TRUE(test::near(test::world_frame_pose(urdf.model, Xu, name), T, 1e-12))
+          << "urdf " << name;
     }
     // The base sensor S: 0.31 m below O_0, parallel to frame 0, whatever q.
     Eigen::Isometry3d S = Eigen::Isometry3d::Identity();
@@ -74,16 +83,20 @@ TEST(PaperArm, MassPropertiesAreTheSpecTableInTheDhFrames) {
     // Link 0: CoM 0.15 m above O_s = 0.31 m below O_0.
     EXPECT_NEAR(m.bodies[0].inertia.mass, 2.0, kTol) << file;
     EXPECT_TRUE(m.bodies[0].inertia.com.isApprox(Vector3(0, 0, 0.15 - 0.31), kTol)) << file;
-    EXPECT_TRUE(m.bodies[0].inertia.inertia_com.isApprox(Vector3(0.020, 0.020, 0.010).asDiagonal().toDenseMatrix(), kTol));
+    EXPECT_TRUE(m.bodies[0].inertia.inertia_com.isApprox(
+        Vector3(0.020, 0.020, 0.010).asDiagonal().toDenseMatrix(), kTol));
     for (int i = 1; i <= 7; ++i) {
       const Inertia& in = m.bodies[static_cast<std::size_t>(i)].inertia;
       const double* I = kInertiaGm2[i - 1];
       Matrix3 expected;
       expected << I[0], I[1], I[2], I[1], I[3], I[4], I[2], I[4], I[5];
       EXPECT_NEAR(in.mass, kMass[i - 1], kTol) << file << " link " << i;
-      EXPECT_LE((in.com - Vector3(kComCm[i - 1][0], kComCm[i - 1][1], kComCm[i - 1][2]) / 100.0).norm(), 1e-12)
+      EXPECT_LE(
+          (in.com - Vector3(kComCm[i - 1][0], kComCm[i - 1][1], kComCm[i - 1][2]) / 100.0).norm(),
+          1e-12)
           << file << " link " << i;
-      EXPECT_LE((in.inertia_com - expected * 1e-3).cwiseAbs().maxCoeff(), 1e-12) << file << " link " << i;
+      EXPECT_LE((in.inertia_com - expected * 1e-3).cwiseAbs().maxCoeff(), 1e-12)
+          << file << " link " << i;
     }
   }
 }
@@ -96,8 +109,10 @@ TEST(PaperArm, YamlAndUrdfHaveTheSameCollisionCapsules) {
   for (std::size_t b = 0; b < 8; ++b) {
     ASSERT_EQ(yaml.geometry.body_shapes[b].size(), 1u) << "one capsule around every link";
     ASSERT_EQ(urdf.geometry.body_shapes[b].size(), 1u);
-    const CollisionShape& y = yaml.geometry.shapes[static_cast<std::size_t>(yaml.geometry.body_shapes[b][0])];
-    const CollisionShape& u = urdf.geometry.shapes[static_cast<std::size_t>(urdf.geometry.body_shapes[b][0])];
+    const CollisionShape& y =
+        yaml.geometry.shapes[static_cast<std::size_t>(yaml.geometry.body_shapes[b][0])];
+    const CollisionShape& u =
+        urdf.geometry.shapes[static_cast<std::size_t>(urdf.geometry.body_shapes[b][0])];
     EXPECT_EQ(y.type, ShapeType::kCapsule);
     EXPECT_EQ(u.type, ShapeType::kCapsule);
     EXPECT_EQ(y.body, static_cast<int>(b));
@@ -108,9 +123,11 @@ TEST(PaperArm, YamlAndUrdfHaveTheSameCollisionCapsules) {
     // Plausible LWR-like sizes, and each capsule contains its link's CoM.
     EXPECT_GE(y.radius, 0.04);
     EXPECT_LE(y.radius, 0.08);
-    const Vector3 c = y.placement.inverse().act(yaml.model.bodies[b].inertia.com);  // CoM in the capsule frame
+    const Vector3 c =
+        y.placement.inverse().act(yaml.model.bodies[b].inertia.com);  // CoM in the capsule frame
     const double along = std::clamp(c.z(), -y.length / 2, y.length / 2);
-    EXPECT_LT((c - Vector3(0, 0, along)).norm(), y.radius) << "CoM of link " << b << " outside its capsule";
+    EXPECT_LT((c - Vector3(0, 0, along)).norm(), y.radius)
+        << "CoM of link " << b << " outside its capsule";
   }
 }
 

@@ -2,13 +2,12 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <numbers>
-
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
 #include <kdl/tree.hpp>
 #include <kdl/treefksolverpos_recursive.hpp>
 #include <kdl_parser/kdl_parser.hpp>
+#include <numbers>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/robot_loader.hpp"
@@ -61,7 +60,9 @@ TEST(Urdf, InertialOriginIsConvertedToTheLinkFrame) {
   EXPECT_DOUBLE_EQ(in.mass, 2.0);
   EXPECT_TRUE(in.com.isApprox(Vector3(0.1, 0.2, 0.3)));
   // Yaw by 90 deg swaps the x and y principal axes: I_link = diag(0.2, 0.3, 0.1).
-  EXPECT_LT((in.inertia_com - Vector3(0.2, 0.3, 0.1).asDiagonal().toDenseMatrix()).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LT(
+      (in.inertia_com - Vector3(0.2, 0.3, 0.1).asDiagonal().toDenseMatrix()).cwiseAbs().maxCoeff(),
+      1e-15);
   EXPECT_TRUE(m.joints[1].axis.isApprox(Vector3::UnitZ()));
   EXPECT_TRUE(std::isinf(m.joints[1].lower));
 }
@@ -118,7 +119,8 @@ TEST(Urdf, CollisionShapesOfMergedLinksArePlacedOnTheirBody) {
   EXPECT_EQ(mesh.type, ShapeType::kMesh);
   EXPECT_EQ(mesh.scale, Vector3(2, 2, 2));
   ASSERT_TRUE(mesh.mesh);
-  EXPECT_EQ(mesh.mesh->vertices.cols(), 0) << "load_meshes = false keeps the shape without triangles";
+  EXPECT_EQ(mesh.mesh->vertices.cols(), 0)
+      << "load_meshes = false keeps the shape without triangles";
   // With load_meshes the unresolvable package is an error naming the line and the attribute.
   LoadOptions o = no_meshes();
   o.load_meshes = true;
@@ -127,7 +129,9 @@ TEST(Urdf, CollisionShapesOfMergedLinksArePlacedOnTheirBody) {
     ADD_FAILURE() << "no error";
   } catch (const Error& e) {
     const std::string msg = e.what();
-    EXPECT_NE(msg.find("inline.urdf:9: <mesh> of link 'tool': attribute 'filename'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("inline.urdf:9: <mesh> of link 'tool': attribute 'filename'"),
+              std::string::npos)
+        << msg;
     EXPECT_NE(msg.find("package 'nowhere'"), std::string::npos) << msg;
   }
 }
@@ -138,7 +142,8 @@ TEST(Urdf, GravityCanBeOverridden) {
   LoadOptions o = no_meshes();
   o.gravity = Vector3(0, 9.81, 0);  // a wall-mounted robot
   EXPECT_TRUE(load_robot(file, o).model.gravity.isApprox(Vector3(0, 9.81, 0)));
-  EXPECT_TRUE(load_robot(test::project_models() / "paper_arm.yaml", o).model.gravity.isApprox(Vector3(0, 9.81, 0)));
+  EXPECT_TRUE(load_robot(test::project_models() / "paper_arm.yaml", o)
+                  .model.gravity.isApprox(Vector3(0, 9.81, 0)));
 }
 
 // ---- the shared validation models ------------------------------------------------------------
@@ -150,7 +155,8 @@ TEST(UrdfShared, PandaLoadsAsATreeWithItsFingers) {
   EXPECT_FALSE(m.is_serial_chain());
   EXPECT_EQ(m.bodies[0].name, "panda_link0");
   const int hand = m.body_index("panda_hand");
-  EXPECT_EQ(hand, m.body_index("panda_link7")) << "hand and link8 merged into link 7 by fixed joints";
+  EXPECT_EQ(hand, m.body_index("panda_link7"))
+      << "hand and link8 merged into link 7 by fixed joints";
   const int left = m.body_index("panda_leftfinger");
   const int right = m.body_index("panda_rightfinger");
   EXPECT_EQ(m.parents[static_cast<std::size_t>(left)], hand);
@@ -164,7 +170,9 @@ TEST(UrdfShared, PandaLoadsAsATreeWithItsFingers) {
 TEST(UrdfShared, Ur5LoadsWithItsWorldLinkMerged) {
   REQUIRE_SHARED();
   for (const char* f : {"ur5_robot.urdf", "ur5_joint_limited_robot.urdf"}) {
-    const Model m = load_robot(test::shared_models() / "ur5/urdf_example-robot-data/urdf" / f, no_meshes()).model;
+    const Model m =
+        load_robot(test::shared_models() / "ur5/urdf_example-robot-data/urdf" / f, no_meshes())
+            .model;
     EXPECT_EQ(m.nq(), 6) << f;
     EXPECT_TRUE(m.is_serial_chain()) << f;
     EXPECT_EQ(m.body_index("base_link"), 0) << f;
@@ -225,7 +233,8 @@ class PackageDir : public ::testing::Test {
     if (!test::have_shared()) GTEST_SKIP() << "no shared models";
     root_ = fs::temp_directory_path() / ("extwrench_pkg_" + std::to_string(::getpid()));
     fs::create_directories(root_ / "example-robot-data/robots");
-    fs::create_directory_symlink(fs::absolute(panda_dir()), root_ / "example-robot-data/robots/panda_description");
+    fs::create_directory_symlink(fs::absolute(panda_dir()),
+                                 root_ / "example-robot-data/robots/panda_description");
   }
   void TearDown() override {
     if (!root_.empty()) fs::remove_all(root_);
@@ -235,7 +244,8 @@ class PackageDir : public ::testing::Test {
 
 int loaded_meshes(const RobotDescription& r) {
   int n = 0;
-  for (const CollisionShape& s : r.geometry.shapes) n += s.type == ShapeType::kMesh && s.mesh && s.mesh->triangles.cols() > 0;
+  for (const CollisionShape& s : r.geometry.shapes)
+    n += s.type == ShapeType::kMesh && s.mesh && s.mesh->triangles.cols() > 0;
   return n;
 }
 
@@ -300,7 +310,8 @@ void compare_with_kdl(const fs::path& file) {
     }
     // Every link: pose, and the world-frame mass properties of every moving body (KDL drops
     // the root link's inertia, so body 0 is left out).
-    std::vector<KDL::RigidBodyInertia> body_inertia(static_cast<std::size_t>(m.num_bodies()), KDL::RigidBodyInertia::Zero());
+    std::vector<KDL::RigidBodyInertia> body_inertia(static_cast<std::size_t>(m.num_bodies()),
+                                                    KDL::RigidBodyInertia::Zero());
     for (const auto& [name, seg] : tree.getSegments()) {
       if (name == tree.getRootSegment()->first) continue;
       KDL::Frame f;
@@ -312,17 +323,22 @@ void compare_with_kdl(const fs::path& file) {
     }
     for (int b = 1; b < m.num_bodies(); ++b) {
       const KDL::RigidBodyInertia& k = body_inertia[static_cast<std::size_t>(b)];
-      const Inertia w = m.bodies[static_cast<std::size_t>(b)].inertia.transformed(X[static_cast<std::size_t>(b)]);
+      const Inertia w =
+          m.bodies[static_cast<std::size_t>(b)].inertia.transformed(X[static_cast<std::size_t>(b)]);
       EXPECT_NEAR(w.mass, k.getMass(), 1e-9);
       if (k.getMass() > 0) {
-        for (int i = 0; i < 3; ++i) EXPECT_NEAR(w.com[i], k.getCOG()(i), 1e-9) << file.filename() << " body " << b;
+        for (int i = 0; i < 3; ++i)
+          EXPECT_NEAR(w.com[i], k.getCOG()(i), 1e-9) << file.filename() << " body " << b;
       }
       // KDL's rotational inertia is about the reference (world) origin.
       const Matrix3 about_origin =
-          w.inertia_com + w.mass * (w.com.squaredNorm() * Matrix3::Identity() - w.com * w.com.transpose());
+          w.inertia_com +
+          w.mass * (w.com.squaredNorm() * Matrix3::Identity() - w.com * w.com.transpose());
       const KDL::RotationalInertia ki = k.getRotationalInertia();
       for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) EXPECT_NEAR(about_origin(r, c), ki.data[3 * r + c], 1e-9) << file.filename() << " body " << b;
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(about_origin(r, c), ki.data[3 * r + c], 1e-9)
+              << file.filename() << " body " << b;
       }
     }
   }

@@ -30,7 +30,8 @@ Inertia cloud_inertia(const std::vector<std::pair<double, Vector3>>& points) {
 
 std::vector<std::pair<double, Vector3>> random_cloud(test::SeededRng& rng, int n) {
   std::vector<std::pair<double, Vector3>> pts;
-  for (int i = 0; i < n; ++i) pts.emplace_back(rng.uniform(0.1, 2.0), rng.uniform_vector3(-0.5, 0.5));
+  for (int i = 0; i < n; ++i)
+    pts.emplace_back(rng.uniform(0.1, 2.0), rng.uniform_vector3(-0.5, 0.5));
   return pts;
 }
 
@@ -44,14 +45,18 @@ Inertia box_inertia(double m, const Vector3& com, double sx, double sy, double s
   Inertia in;
   in.mass = m;
   in.com = com;
-  in.inertia_com.diagonal() << m / 12 * (sy * sy + sz * sz), m / 12 * (sx * sx + sz * sz), m / 12 * (sx * sx + sy * sy);
+  in.inertia_com.diagonal() << m / 12 * (sy * sy + sz * sz), m / 12 * (sx * sx + sz * sz),
+      m / 12 * (sx * sx + sy * sy);
   return in;
 }
 
-LinkSpec link(const std::string& name, const Inertia& in) { return LinkSpec{name, in, "test.urdf:" + name, ""}; }
+LinkSpec link(const std::string& name, const Inertia& in) {
+  return LinkSpec{name, in, "test.urdf:" + name, ""};
+}
 
-JointSpec joint(const std::string& name, JointSpecType type, const std::string& parent, const std::string& child,
-                const Pose& origin = Pose::identity(), const Vector3& axis = Vector3::UnitZ()) {
+JointSpec joint(const std::string& name, JointSpecType type, const std::string& parent,
+                const std::string& child, const Pose& origin = Pose::identity(),
+                const Vector3& axis = Vector3::UnitZ()) {
   JointSpec j;
   j.name = name;
   j.type = type;
@@ -103,7 +108,8 @@ TEST(ValidateInertia, AcceptsBoxesPointMassesAndThinRods) {
   Inertia point;
   point.mass = 2.0;
   EXPECT_NO_THROW(validate_inertia(point, "point"));
-  Inertia rod;  // thin rod along z: I_zz = 0, I_xx = I_yy -> triangle inequality holds with equality
+  Inertia
+      rod;  // thin rod along z: I_zz = 0, I_xx = I_yy -> triangle inequality holds with equality
   rod.mass = 1.0;
   rod.inertia_com.diagonal() << 1.0 / 12, 1.0 / 12, 0.0;
   EXPECT_NO_THROW(validate_inertia(rod, "rod"));
@@ -147,9 +153,9 @@ TEST(ModelBuilder, SerialChainHasPaperIndexingAndAFramePerLink) {
   b.set_name("chain");
   for (int i = 0; i <= 3; ++i) b.add_link(link("l" + std::to_string(i), kBox));
   for (int i = 1; i <= 3; ++i) {
-    b.add_joint(joint("j" + std::to_string(i), JointSpecType::kRevolute, "l" + std::to_string(i - 1),
-                      "l" + std::to_string(i), Pose::from_xyz_rpy(Vector3(0, 0, 0.3), Vector3::Zero()),
-                      Vector3(0, 0, 2.0)));
+    b.add_joint(joint("j" + std::to_string(i), JointSpecType::kRevolute,
+                      "l" + std::to_string(i - 1), "l" + std::to_string(i),
+                      Pose::from_xyz_rpy(Vector3(0, 0, 0.3), Vector3::Zero()), Vector3(0, 0, 2.0)));
   }
   const Model m = b.build();
   EXPECT_EQ(m.nq(), 3);
@@ -174,9 +180,12 @@ TEST(ModelBuilder, TreeBodiesAreDepthFirstWithParentsBeforeChildren) {
   for (const char* n : {"c2", "root", "b1", "c1", "a1", "b2"}) b.add_link(link(n, kBox));
   b.add_joint(joint("jb2", JointSpecType::kRevolute, "b1", "b2"));
   b.add_joint(joint("ja1", JointSpecType::kRevolute, "root", "a1"));
-  b.add_joint(joint("jb1", JointSpecType::kRevolute, "root", "b1", Pose::identity(), Vector3::UnitX()));
-  b.add_joint(joint("jc1", JointSpecType::kPrismatic, "a1", "c1", Pose::identity(), Vector3::UnitY()));
-  b.add_joint(joint("jc2", JointSpecType::kContinuous, "a1", "c2", Pose::identity(), Vector3::UnitX()));
+  b.add_joint(
+      joint("jb1", JointSpecType::kRevolute, "root", "b1", Pose::identity(), Vector3::UnitX()));
+  b.add_joint(
+      joint("jc1", JointSpecType::kPrismatic, "a1", "c1", Pose::identity(), Vector3::UnitY()));
+  b.add_joint(
+      joint("jc2", JointSpecType::kContinuous, "a1", "c2", Pose::identity(), Vector3::UnitX()));
   const Model m = b.build();
   ASSERT_EQ(m.num_bodies(), 6);
   EXPECT_EQ(m.bodies[0].name, "root");
@@ -187,7 +196,7 @@ TEST(ModelBuilder, TreeBodiesAreDepthFirstWithParentsBeforeChildren) {
               m.joints[static_cast<std::size_t>(i)].name == "jb2"   ? "b1"
               : m.joints[static_cast<std::size_t>(i)].name == "jc1" ? "a1"
               : m.joints[static_cast<std::size_t>(i)].name == "jc2" ? "a1"
-                                                                      : "root");
+                                                                    : "root");
   }
   // Depth first: a subtree is contiguous (a1's children directly follow it).
   const int a1 = m.body_index("a1");
@@ -195,7 +204,8 @@ TEST(ModelBuilder, TreeBodiesAreDepthFirstWithParentsBeforeChildren) {
   EXPECT_EQ(m.parents[static_cast<std::size_t>(a1 + 2)], a1);
   const int c2 = m.body_index("c2");
   EXPECT_EQ(m.joints[static_cast<std::size_t>(c2)].type, JointType::kRevolute);
-  EXPECT_TRUE(std::isinf(m.joints[static_cast<std::size_t>(c2)].upper)) << "continuous joints have no limits";
+  EXPECT_TRUE(std::isinf(m.joints[static_cast<std::size_t>(c2)].upper))
+      << "continuous joints have no limits";
   EXPECT_EQ(m.joints[static_cast<std::size_t>(m.body_index("c1"))].type, JointType::kPrismatic);
 }
 
@@ -251,7 +261,8 @@ TEST(ModelBuilder, MasslessIntermediateLinkIsFineWhenTheMassMatrixStaysDefinite)
   b.add_link(link("mid", Inertia{}));
   b.add_link(link("hand", kBox));
   b.add_joint(joint("j1", JointSpecType::kRevolute, "base", "mid"));
-  b.add_joint(joint("j2", JointSpecType::kRevolute, "mid", "hand", Pose::identity(), Vector3::UnitY()));
+  b.add_joint(
+      joint("j2", JointSpecType::kRevolute, "mid", "hand", Pose::identity(), Vector3::UnitY()));
   EXPECT_NO_THROW((void)b.build());
 }
 
@@ -292,16 +303,19 @@ TEST(ModelBuilder, StructuralErrorsNameTheSourceElementAndField) {
     b.add_joint(joint("j1", JointSpecType::kRevolute, "l0", "l1"));
   };
   const Case cases[] = {
-      {"duplicate link", [](ModelBuilder& b) { b.add_link(link("l1", kBox)); }, "test.urdf:l1: link 'l1'", "duplicate"},
+      {"duplicate link", [](ModelBuilder& b) { b.add_link(link("l1", kBox)); },
+       "test.urdf:l1: link 'l1'", "duplicate"},
       {"duplicate joint",
        [](ModelBuilder& b) {
          b.add_link(link("l2", kBox));
          b.add_joint(joint("j1", JointSpecType::kRevolute, "l1", "l2"));
        },
        "test.urdf:j1: joint 'j1'", "duplicate joint name"},
-      {"missing parent", [](ModelBuilder& b) { b.add_joint(joint("j2", JointSpecType::kRevolute, "nope", "l1")); },
+      {"missing parent",
+       [](ModelBuilder& b) { b.add_joint(joint("j2", JointSpecType::kRevolute, "nope", "l1")); },
        "test.urdf:j2: joint 'j2'", "parent: no link named 'nope'"},
-      {"missing child", [](ModelBuilder& b) { b.add_joint(joint("j2", JointSpecType::kRevolute, "l1", "nope")); },
+      {"missing child",
+       [](ModelBuilder& b) { b.add_joint(joint("j2", JointSpecType::kRevolute, "l1", "nope")); },
        "test.urdf:j2: joint 'j2'", "child: no link named 'nope'"},
       {"two parents",
        [](ModelBuilder& b) {
@@ -310,8 +324,8 @@ TEST(ModelBuilder, StructuralErrorsNameTheSourceElementAndField) {
          b.add_joint(joint("j3", JointSpecType::kRevolute, "l1", "l2"));
        },
        "test.urdf:j3: joint 'j3'", "already has a parent joint 'j2'"},
-      {"two roots", [](ModelBuilder& b) { b.add_link(link("island", kBox)); }, "test.urdf:island: link 'island'",
-       "more than one root"},
+      {"two roots", [](ModelBuilder& b) { b.add_link(link("island", kBox)); },
+       "test.urdf:island: link 'island'", "more than one root"},
       {"cycle",
        [](ModelBuilder& b) {
          b.add_link(link("x", kBox));
@@ -323,7 +337,8 @@ TEST(ModelBuilder, StructuralErrorsNameTheSourceElementAndField) {
       {"zero axis",
        [](ModelBuilder& b) {
          b.add_link(link("l2", kBox));
-         b.add_joint(joint("j2", JointSpecType::kRevolute, "l1", "l2", Pose::identity(), Vector3::Zero()));
+         b.add_joint(
+             joint("j2", JointSpecType::kRevolute, "l1", "l2", Pose::identity(), Vector3::Zero()));
        },
        "test.urdf:j2: joint 'j2'", "axis: must not be zero"},
       {"limits",
@@ -349,7 +364,10 @@ TEST(ModelBuilder, StructuralErrorsNameTheSourceElementAndField) {
          b.add_link(link("l2", in));
        },
        "test.urdf:l2: link 'l2'", "mass: must not be negative"},
-      {"unknown frame link", [](ModelBuilder& b) { b.add_frame(FrameSpec{"tool", "nope", Pose(), "test:tool"}); },
+      {"unknown frame link",
+       [](ModelBuilder& b) {
+         b.add_frame(FrameSpec{"tool", "nope", Pose(), "test:tool"});
+       },
        "test:tool: frame 'tool'", "no link or frame named 'nope'"},
   };
   for (const Case& c : cases) {

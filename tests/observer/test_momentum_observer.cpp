@@ -23,7 +23,7 @@ constexpr double kDt = 1e-3;
 // constant joint-space τ_ext starts at t_on (a sample time).
 struct LoopResult {
   double max_error_before = 0.0;  // max |r| before the onset
-  double max_law_error = 0.0;     // max |r − (1 − e^{−K (t − t_on)}) τ_ext| after the onset
+  double max_law_error = 0.0;  // max |r − (1 − e^{−K (t − t_on)}) τ_ext| after the onset
 };
 
 LoopResult run_constant_torque_loop(double gain, const VectorX& tau_ext, double t_on, double t_end,
@@ -64,7 +64,8 @@ LoopResult run_constant_torque_loop(double gain, const VectorX& tau_ext, double 
 TEST(MomentumObserver, ResidualFollowsTheFirstOrderLawAfterAConstantExternalTorque) {
   const VectorX tau_ext = (VectorX(7) << 3, -2, 1.5, 1, -0.5, 0.4, 0.2).finished();
   for (double gain : {50.0, 100.0, 200.0}) {
-    const LoopResult res = run_constant_torque_loop(gain, tau_ext, 0.3, 0.3 + 8 / gain + 0.2, false);
+    const LoopResult res =
+        run_constant_torque_loop(gain, tau_ext, 0.3, 0.3 + 8 / gain + 0.2, false);
     // Exact model: without contact the residual is the integration error only (O(Δt²)).
     EXPECT_LT(res.max_error_before, 1e-4) << "K = " << gain;
     // With contact: r_k = (1 − e^{−K t}) τ_ext up to the trapezoidal error of Cᵀq̇ − g.
@@ -105,7 +106,8 @@ TEST(MomentumObserver, PerJointGainsGiveEachJointItsOwnTimeConstant) {
 TEST(MomentumObserver, NonIncreasingTimeIsRejectedAndChangesNothing) {
   const Model model = test::paper_arm_model();
   MomentumObserver obs(model, 100.0);
-  const VectorX q = VectorX::Constant(7, 0.2), dq = VectorX::Constant(7, 0.1), tau = VectorX::Ones(7);
+  const VectorX q = VectorX::Constant(7, 0.2), dq = VectorX::Constant(7, 0.1),
+                tau = VectorX::Ones(7);
   ASSERT_TRUE(obs.reset(1.0, q, dq, tau).ok());
   ASSERT_TRUE(obs.update(1.001, q, dq, tau).ok());
   const VectorX r = obs.residual();
@@ -195,7 +197,8 @@ TEST(MomentumObserver, KnownViscousAndCoulombFrictionIsNotMistakenForContact) {
       max_with = std::max(max_with, with.residual().cwiseAbs().maxCoeff());
       // Without the model, r tracks −τ_f (lagged by 1/K).
       const VectorX expected = -friction.viscous.cwiseProduct(arm.dq);
-      max_without_error = std::max(max_without_error, (without.residual() - expected).cwiseAbs().maxCoeff());
+      max_without_error =
+          std::max(max_without_error, (without.residual() - expected).cwiseAbs().maxCoeff());
     }
   }
   EXPECT_LT(max_with, 1e-4);

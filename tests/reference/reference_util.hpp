@@ -2,6 +2,9 @@
 // it that the reference library can parse on its own (no extwrench code involved).
 #pragma once
 
+#include <tinyxml2.h>
+
+#include <Eigen/Geometry>
 #include <fstream>
 #include <map>
 #include <set>
@@ -9,9 +12,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <tinyxml2.h>
 
 namespace extwrench::test {
 
@@ -93,7 +93,8 @@ inline std::string urdf_for_reference(const std::string& xml, const UrdfEditOpti
     tinyxml2::XMLDocument frag;
     const std::string wrapped = "<x>" + extra + "</x>";
     if (frag.Parse(wrapped.c_str()) != tinyxml2::XML_SUCCESS) throw std::runtime_error("bad extra");
-    for (auto* e = frag.FirstChildElement("x")->FirstChildElement(); e; e = e->NextSiblingElement()) {
+    for (auto* e = frag.FirstChildElement("x")->FirstChildElement(); e;
+         e = e->NextSiblingElement()) {
       robot->InsertEndChild(e->DeepClone(&doc));
     }
   }
@@ -105,9 +106,9 @@ inline std::string urdf_for_reference(const std::string& xml, const UrdfEditOpti
 /// A link's <inertial>, read directly from the URDF text.
 struct UrdfInertial {
   double mass = 0.0;
-  Eigen::Vector3d com = Eigen::Vector3d::Zero();       ///< origin xyz, link frame
+  Eigen::Vector3d com = Eigen::Vector3d::Zero();           ///< origin xyz, link frame
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  ///< origin rpy, link frame
-  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();   ///< about the CoM, inertial-frame axes
+  Eigen::Matrix3d inertia = Eigen::Matrix3d::Zero();       ///< about the CoM, inertial-frame axes
 };
 
 inline Eigen::Vector3d parse_triple(const char* text) {

@@ -13,15 +13,14 @@
 //  - The base wrench is not an output of KDL: it is measured by six virtual joints (x, y, z
 //    translations, then x, y, z rotations, all at the sensor frame, massless) inserted between
 //    the ground and link 0, held at q = dq = ddq = 0. Their torques are the components of the
-//    wrench the ground transmits to link 0, in the sensor frame, moment about O_s: f_0 = −(f_m, n_m).
+//    wrench the ground transmits to link 0, in the sensor frame, moment about O_s: f_0 = −(f_m,
+//    n_m).
+#include <gtest/gtest.h>
+
 #include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <string>
-#include <vector>
-
-#include <gtest/gtest.h>
 #include <kdl/chain.hpp>
 #include <kdl/chaindynparam.hpp>
 #include <kdl/chainfksolverpos_recursive.hpp>
@@ -34,6 +33,8 @@
 #include <kdl/tree.hpp>
 #include <kdl/treeidsolver_recursive_newton_euler.hpp>
 #include <kdl_parser/kdl_parser.hpp>
+#include <string>
+#include <vector>
 
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -85,12 +86,12 @@ struct Worst {
 struct Reference {
   RobotDescription robot;
   KDL::Tree tree;
-  KDL::Chain chain;         ///< kdl_world -> tip: link 0 (fixed, with its inertia), links 1..n
-  KDL::Chain sensor_chain;  ///< ground -> sensor -> 6 virtual joints -> link 0 -> ... -> tip
-  Pose X_WS;                ///< sensor pose in the root frame
-  std::vector<int> q_index; ///< KDL joint k is our q[q_index[k]]
+  KDL::Chain chain;          ///< kdl_world -> tip: link 0 (fixed, with its inertia), links 1..n
+  KDL::Chain sensor_chain;   ///< ground -> sensor -> 6 virtual joints -> link 0 -> ... -> tip
+  Pose X_WS;                 ///< sensor pose in the root frame
+  std::vector<int> q_index;  ///< KDL joint k is our q[q_index[k]]
   std::vector<int> segment_frame;  ///< chain segment s is our frame segment_frame[s]
-  MatrixX P;                ///< x_kdl = P x_ours
+  MatrixX P;                       ///< x_kdl = P x_ours
 
   int n() const { return static_cast<int>(q_index.size()); }
   KDL::JntArray to_kdl_q(const VectorX& x) const {
@@ -107,7 +108,7 @@ struct RobotCase {
   std::string tip;        ///< chain tip; the URDF is truncated to root -> tip when `truncate`
   bool truncate;
   std::string sensor_link;  ///< sensor frame from the URDF, or empty for kArbitrarySensor
-  bool dh = false;  ///< a DH YAML, compared with the SPEC table through KDL::Frame::DH
+  bool dh = false;          ///< a DH YAML, compared with the SPEC table through KDL::Frame::DH
 };
 
 const Pose kArbitrarySensor =
@@ -265,8 +266,8 @@ TEST_P(KdlReference, LinkFramePosesMatchKdlForwardKinematics) {
       ASSERT_GE(fk.JntToCart(q, f, static_cast<int>(s + 1)), 0);
       const Pose X_ref = from_kdl(f);
       const Pose X = frame_pose(model(), data, ref_.segment_frame[s]);
-      const double e = std::max(rel_err(X.rotation, X_ref.rotation),
-                                rel_err(X.translation, X_ref.translation));
+      const double e =
+          std::max(rel_err(X.rotation, X_ref.rotation), rel_err(X.translation, X_ref.translation));
       worst.update(e);
       EXPECT_LE(e, kTol) << ref_.chain.getSegment(s).getName();
     }
@@ -275,8 +276,8 @@ TEST_P(KdlReference, LinkFramePosesMatchKdlForwardKinematics) {
 
 // Torques and the base wrench, with random external wrenches on random links (link 0 included)
 // when `with_wrenches`.
-void check_rnea(const Reference& ref, const Model& model,
-                bool with_wrenches, unsigned seed, const std::string& label) {
+void check_rnea(const Reference& ref, const Model& model, bool with_wrenches, unsigned seed,
+                const std::string& label) {
   Data data(model);
   const KDL::Vector g(model.gravity.x(), model.gravity.y(), model.gravity.z());
   KDL::ChainIdSolver_RNE id(ref.chain, g);
@@ -307,7 +308,8 @@ void check_rnea(const Reference& ref, const Model& model,
     const Vector6 reading = sensor_reading(data, ref.X_WS);
 
     KDL::JntArray tau_ref(static_cast<unsigned>(n));
-    ASSERT_GE(id.CartToJnt(ref.to_kdl_q(q), ref.to_kdl_q(dq), ref.to_kdl_q(ddq), f_ext, tau_ref), 0);
+    ASSERT_GE(id.CartToJnt(ref.to_kdl_q(q), ref.to_kdl_q(dq), ref.to_kdl_q(ddq), f_ext, tau_ref),
+              0);
     const double e_tau = rel_err(ref.P * tau, tau_ref.data);
     worst_tau.update(e_tau);
     EXPECT_LE(e_tau, kTol) << "state " << k;
@@ -379,8 +381,8 @@ TEST_P(KdlReference, CoriolisTimesVelocityMatchesKdl) {
     const VectorX c_dq = coriolis_matrix(model(), data, x.q, x.dq) * x.dq;
     const VectorX bias = bias_torques(model(), data, x.q, x.dq);
     const VectorX g = gravity_torques(model(), data, x.q);
-    const double e = std::max(rel_err(ref_.P * c_dq, c_ref.data),
-                              rel_err(ref_.P * (bias - g), c_ref.data));
+    const double e =
+        std::max(rel_err(ref_.P * c_dq, c_ref.data), rel_err(ref_.P * (bias - g), c_ref.data));
     worst.update(e);
     EXPECT_LE(e, kTol) << "state " << k;
     // The fused momentum + bias pass: c(q, dq) - g(q) against KDL's C dq, and its ground
@@ -390,7 +392,8 @@ TEST_P(KdlReference, CoriolisTimesVelocityMatchesKdl) {
       return data.root_wrench_W;
     }();
     momentum_and_bias_terms(model(), data, x.q, x.dq);
-    EXPECT_LE(rel_err(ref_.P * (data.tau - data.gravity_torque), c_ref.data), kTol) << "state " << k;
+    EXPECT_LE(rel_err(ref_.P * (data.tau - data.gravity_torque), c_ref.data), kTol)
+        << "state " << k;
     EXPECT_LE(rel_err(data.root_wrench_W, root_ref), kTol) << "state " << k;
   }
 }

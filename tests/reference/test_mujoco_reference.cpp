@@ -24,16 +24,16 @@
 //  - after mj_rnePostConstraint, cfrc_int[b] = [torque; force] ([angular; linear]!) that the
 //    parent applies to body b, world axes, moment about subtree_com[body_rootid[b]]. For body 1
 //    (link 0) that is f_0, the wrench the ground applies to the robot: the sensor reads −f_0.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Eigenvalues>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <Eigen/Eigenvalues>
-#include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
 
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
@@ -263,7 +263,8 @@ void MujocoReference::run(bool with_wrenches, unsigned seed) {
     EXPECT_LE(e_tau, kTol) << "state " << k << "\nours " << tau.transpose() << "\nmj   "
                            << tau_ref.transpose();
 
-    // f_0 from cfrc_int of link 0 ([torque about c; force]), moved to O_s: n_0(O_s) = n_c + (c − O_s) × f.
+    // f_0 from cfrc_int of link 0 ([torque about c; force]), moved to O_s: n_0(O_s) = n_c + (c −
+    // O_s) × f.
     const Vector3 c = vec3(d->subtree_com + 3 * m->body_rootid[1]);
     const Vector3 f0 = vec3(d->cfrc_int + 6 + 3);
     const Vector3 n0 = vec3(d->cfrc_int + 6) + (c - X_WS_.translation).cross(f0);
@@ -277,9 +278,7 @@ void MujocoReference::run(bool with_wrenches, unsigned seed) {
   }
 }
 
-TEST_P(MujocoReference, TorquesAndBaseWrenchMatchMujocoWithoutExternalWrenches) {
-  run(false, 201);
-}
+TEST_P(MujocoReference, TorquesAndBaseWrenchMatchMujocoWithoutExternalWrenches) { run(false, 201); }
 
 TEST_P(MujocoReference, TorquesAndBaseWrenchMatchMujocoWithExternalWrenches) { run(true, 202); }
 
@@ -305,12 +304,13 @@ TEST_P(MujocoReference, StaticRobotDischargesItsWeightOnTheSensor) {
 
 INSTANTIATE_TEST_SUITE_P(
     Robots, MujocoReference,
-    ::testing::Values(
-        RobotCase{"paper_arm", "models/paper_arm.urdf", false, "", "sensor"},
-        RobotCase{"panda_chain", "models/franka_panda/urdf_example-robot-data/urdf/panda.urdf",
-                  true, "panda_link7", ""},
-        RobotCase{"panda_tree", "models/franka_panda/urdf_example-robot-data/urdf/panda.urdf",
-                  true, "", ""}),
+    ::testing::Values(RobotCase{"paper_arm", "models/paper_arm.urdf", false, "", "sensor"},
+                      RobotCase{"panda_chain",
+                                "models/franka_panda/urdf_example-robot-data/urdf/panda.urdf", true,
+                                "panda_link7", ""},
+                      RobotCase{"panda_tree",
+                                "models/franka_panda/urdf_example-robot-data/urdf/panda.urdf", true,
+                                "", ""}),
     [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace

@@ -1,18 +1,17 @@
 // Logs, scenarios and replay: round trips, malformed inputs with the expected messages, the
 // URDF writer, estimate reproducing simulate byte for byte, and the paper's acceptance.
-#include <gtest/gtest.h>
-
-#include <cstdio>
-#include <cstdlib>
-#include <functional>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
-
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/rnea.hpp"
@@ -32,7 +31,8 @@ const fs::path kSource = EXTWRENCH_SOURCE_DIR;
 const fs::path kPaperArm = kSource / "models" / "paper_arm.urdf";
 
 fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("extwrench_test_replay_" + std::to_string(::getpid())) / name;
+  const fs::path dir =
+      fs::temp_directory_path() / ("extwrench_test_replay_" + std::to_string(::getpid())) / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
@@ -64,7 +64,9 @@ class Replay : public ::testing::Test {
   static void SetUpTestSuite() { robot_ = new RobotDescription(load_robot(kPaperArm)); }
   static void TearDownTestSuite() {
     std::error_code ignored;
-    fs::remove_all(fs::temp_directory_path() / ("extwrench_test_replay_" + std::to_string(::getpid())), ignored);
+    fs::remove_all(
+        fs::temp_directory_path() / ("extwrench_test_replay_" + std::to_string(::getpid())),
+        ignored);
     delete robot_;
     robot_ = nullptr;
   }
@@ -93,7 +95,8 @@ sim::Sample random_sample(test::SeededRng& rng, double t, int n) {
 
 TEST_F(Replay, LogWrittenThenReadGivesBackEveryNumberBitForBit) {
   const fs::path dir = temp_dir("roundtrip");
-  LogLayout layout{.n = 7, .velocity = true, .force = true, .moment = true, .truth = true, .true_tau_ext = true};
+  LogLayout layout{
+      .n = 7, .velocity = true, .force = true, .moment = true, .truth = true, .true_tau_ext = true};
   test::SeededRng rng(3);
   std::vector<sim::Sample> written;
   {
@@ -159,7 +162,8 @@ TEST_F(Replay, LogWithoutVelocitiesIsDifferentiated) {
 std::string header(bool dq = true, const std::string& extra = "") {
   std::string h = "t";
   for (int i = 1; i <= 7; ++i) h += ",q" + std::to_string(i);
-  if (dq) for (int i = 1; i <= 7; ++i) h += ",dq" + std::to_string(i);
+  if (dq)
+    for (int i = 1; i <= 7; ++i) h += ",dq" + std::to_string(i);
   for (int i = 1; i <= 7; ++i) h += ",tau" + std::to_string(i);
   return h + extra + "\n";
 }
@@ -185,19 +189,26 @@ struct BadLog {
 TEST_F(Replay, MalformedLogsAreErrorsNamingLineAndColumn) {
   const std::vector<BadLog> cases = {
       {"missing_q3", "t,q1,q2,q4\n0,1,2,3\n", ":1: missing column 'q3'"},
-      {"missing_tau7", header(true).substr(0, header(true).size() - 6) + "\n" + row(0, 20), "missing column 'tau7'"},
-      {"partial_dq", "t,q1,q2,q3,q4,q5,q6,q7,dq1,tau1,tau2,tau3,tau4,tau5,tau6,tau7\n", "missing column 'dq2'"},
+      {"missing_tau7", header(true).substr(0, header(true).size() - 6) + "\n" + row(0, 20),
+       "missing column 'tau7'"},
+      {"partial_dq", "t,q1,q2,q3,q4,q5,q6,q7,dq1,tau1,tau2,tau3,tau4,tau5,tau6,tau7\n",
+       "missing column 'dq2'"},
       {"bad_number", header() + row(0, 21) + "0.001,0.1,abc" + repeat(",0.1", 19) + "\n",
        ":3: column 3 'q2': expected a number, got 'abc'"},
-      {"non_increasing", header() + row(0.002, 21) + row(0.001, 21), ":3: column 1 't': time must increase"},
+      {"non_increasing", header() + row(0.002, 21) + row(0.001, 21),
+       ":3: column 1 't': time must increase"},
       {"repeated_time", header() + row(0.0, 21) + row(0.0, 21), "time must increase"},
       {"short_row", header() + "0,1,2\n", ":2:"},
       {"partial_sensor", header(true, ",fs_x,fs_y") + row(0, 23), "missing column 'fs_z'"},
-      {"moment_without_force", header(true, ",ms_x,ms_y,ms_z") + row(0, 24), "ms_x..ms_z need fs_x..fs_z"},
-      {"truth_without_link", header(true, ",true_fx,true_fy,true_fz") + row(0, 24), "missing column 'true_link'"},
-      {"unknown_link", header(true, ",true_link,true_fx,true_fy,true_fz") + row(0, 21, ",link9,1,2,3"),
+      {"moment_without_force", header(true, ",ms_x,ms_y,ms_z") + row(0, 24),
+       "ms_x..ms_z need fs_x..fs_z"},
+      {"truth_without_link", header(true, ",true_fx,true_fy,true_fz") + row(0, 24),
+       "missing column 'true_link'"},
+      {"unknown_link",
+       header(true, ",true_link,true_fx,true_fy,true_fz") + row(0, 21, ",link9,1,2,3"),
        "'link9' is not a link of robot 'paper_arm'"},
-      {"empty_truth_in_contact", header(true, ",true_link,true_fx,true_fy,true_fz") + row(0, 21, ",link6,1,,3"),
+      {"empty_truth_in_contact",
+       header(true, ",true_link,true_fx,true_fy,true_fz") + row(0, 21, ",link6,1,,3"),
        "column 25 'true_fy': expected a number (true_link is 'link6')"},
       {"nan_position", header() + "0,nan" + repeat(",0.1", 20) + "\n", "column 2 'q1'"},
       {"empty_file", "", "header"},
@@ -226,14 +237,17 @@ TEST_F(Replay, ConfigNeedingSensorColumnsIsAnErrorOnALogWithout) {
   ro.log = dir / "log.csv";
   ro.out_dir = dir / "out";
   ro.figures = false;
-  const std::string what = error_of([&] { (void)replay_log(robot_->model, robot_->geometry, options, ro); });
-  EXPECT_NE(what.find("sensor.type is 'ft' but the log has no fs_x..fs_z, ms_x..ms_z columns"), std::string::npos)
+  const std::string what =
+      error_of([&] { (void)replay_log(robot_->model, robot_->geometry, options, ro); });
+  EXPECT_NE(what.find("sensor.type is 'ft' but the log has no fs_x..fs_z, ms_x..ms_z columns"),
+            std::string::npos)
       << what;
   // A header without rows.
   write_file(dir / "empty.csv", header());
   options.sensor.type = SensorType::kNone;
   ro.log = dir / "empty.csv";
-  const std::string what2 = error_of([&] { (void)replay_log(robot_->model, robot_->geometry, options, ro); });
+  const std::string what2 =
+      error_of([&] { (void)replay_log(robot_->model, robot_->geometry, options, ro); });
   EXPECT_NE(what2.find("empty.csv: the log has a header but no rows"), std::string::npos) << what2;
 }
 
@@ -259,28 +273,40 @@ std::string replace(std::string text, const std::string& from, const std::string
 TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
   const std::vector<BadLog> cases = {
       {"unknown_key", kGoodScenario + "colour: red\n", "colour: unknown key"},
-      {"missing_robot", replace(kGoodScenario, "robot: " + kPaperArm.string(), ""), "robot: missing"},
-      {"robot_not_found", replace(kGoodScenario, kPaperArm.string(), "nowhere.urdf"), "robot: no such file"},
+      {"missing_robot", replace(kGoodScenario, "robot: " + kPaperArm.string(), ""),
+       "robot: missing"},
+      {"robot_not_found", replace(kGoodScenario, kPaperArm.string(), "nowhere.urdf"),
+       "robot: no such file"},
       {"trajectory_size", replace(kGoodScenario, "offset: 0.3", "offset: [1, 2]"),
        ":4: trajectory.offset: expected 7 numbers (or one for all), got 2"},
-      {"trajectory_key", replace(kGoodScenario, "phase: 0", "phase: 0, speed: 1"), "trajectory.speed: unknown key"},
+      {"trajectory_key", replace(kGoodScenario, "phase: 0", "phase: 0, speed: 1"),
+       "trajectory.speed: unknown key"},
       {"bad_number", replace(kGoodScenario, "duration: 0.5", "duration: fast"),
        ":3: duration: expected a finite number, got 'fast'"},
-      {"negative_duration", replace(kGoodScenario, "duration: 0.5", "duration: -1"), "duration: expected a positive number"},
+      {"negative_duration", replace(kGoodScenario, "duration: 0.5", "duration: -1"),
+       "duration: expected a positive number"},
       {"unknown_frame", replace(kGoodScenario, "frame: link6", "frame: link8"),
        "forces[0].frame: 'link8' is not a frame of robot 'paper_arm'"},
       {"bad_axes", replace(kGoodScenario, "frame: link6,", "frame: link6, axes: tool,"),
        "forces[0].axes: expected 'frame' or 'world', got 'tool'"},
-      {"force_size", replace(kGoodScenario, "force: [20, 0, 0]", "force: [20, 0]"), "forces[0].force: expected 3 numbers"},
-      {"end_before_start", replace(kGoodScenario, "start: 0.1", "start: 0.1, end: 0.05"), "end must be after start"},
-      {"model_error", kGoodScenario + "model_error: 0.7\n", "model_error: expected a fraction in [0, 0.5)"},
-      {"sensor_type", kGoodScenario + "sensors: {base: {type: laser}}\n", "sensors.base.type: expected ft, force or none"},
-      {"gains_conflict", kGoodScenario + "controller: {omega: 10, kp: 100}\n", "give omega or kp/kd/ki, not both"},
-      {"seed_fraction", replace(kGoodScenario, "seeds: [1]", "seeds: [1.5]"), "seeds[0]: expected a non-negative integer"},
-      {"exclude_reversed", kGoodScenario + "metrics: {exclude: [[2, 1]]}\n", "metrics.exclude[0]: expected [from, to] with from < to"},
+      {"force_size", replace(kGoodScenario, "force: [20, 0, 0]", "force: [20, 0]"),
+       "forces[0].force: expected 3 numbers"},
+      {"end_before_start", replace(kGoodScenario, "start: 0.1", "start: 0.1, end: 0.05"),
+       "end must be after start"},
+      {"model_error", kGoodScenario + "model_error: 0.7\n",
+       "model_error: expected a fraction in [0, 0.5)"},
+      {"sensor_type", kGoodScenario + "sensors: {base: {type: laser}}\n",
+       "sensors.base.type: expected ft, force or none"},
+      {"gains_conflict", kGoodScenario + "controller: {omega: 10, kp: 100}\n",
+       "give omega or kp/kd/ki, not both"},
+      {"seed_fraction", replace(kGoodScenario, "seeds: [1]", "seeds: [1.5]"),
+       "seeds[0]: expected a non-negative integer"},
+      {"exclude_reversed", kGoodScenario + "metrics: {exclude: [[2, 1]]}\n",
+       "metrics.exclude[0]: expected [from, to] with from < to"},
       {"scheme_robot", replace(kGoodScenario, "ft: {sensor", "ft: {robot: x.urdf, sensor"),
        "schemes.ft.robot: schemes use the scenario's perturbed model"},
-      {"scheme_without_sensor", replace(kGoodScenario, "ft: {sensor: {type: ft}, ", "ft: {"), "schemes.ft.sensor.type: missing"},
+      {"scheme_without_sensor", replace(kGoodScenario, "ft: {sensor: {type: ft}, ", "ft: {"),
+       "schemes.ft.sensor.type: missing"},
       {"no_schemes", kGoodScenario.substr(0, kGoodScenario.find("schemes:")), "schemes: missing"},
       {"yaml_syntax", kGoodScenario + "forces: [\n", "YAML syntax error"},
       {"substeps", kGoodScenario + "substeps: 2.5\n", "substeps: expected an integer in [1, 1000]"},
@@ -297,9 +323,11 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
 
 TEST_F(Replay, SchemeWithABadEstimatorKeyFailsBeforeSimulatingAndNamesTheScheme) {
   const fs::path dir = temp_dir("badscheme");
-  write_file(dir / "s.yaml", replace(kGoodScenario, "contact: {model: pure_force}", "contact: {model: magic}"));
+  write_file(dir / "s.yaml",
+             replace(kGoodScenario, "contact: {model: pure_force}", "contact: {model: magic}"));
   const Scenario s = load_scenario(dir / "s.yaml");
-  const std::string what = error_of([&] { (void)run_scenario(s, dir / "out", RunOptions{.figures = false}); });
+  const std::string what =
+      error_of([&] { (void)run_scenario(s, dir / "out", RunOptions{.figures = false}); });
   EXPECT_NE(what.find("scheme 'ft'"), std::string::npos) << what;
   EXPECT_NE(what.find("contact.model"), std::string::npos) << what;
   EXPECT_FALSE(fs::exists(dir / "out" / "log.csv"));
@@ -318,7 +346,9 @@ TEST_F(Replay, WrittenUrdfLoadsBackToTheSameDynamics) {
     // (m c / m, parallel-axis terms) may round the last bit.
     EXPECT_EQ(back.model.bodies[b].inertia.mass, perturbed.bodies[b].inertia.mass);
     EXPECT_LT((back.model.bodies[b].inertia.com - perturbed.bodies[b].inertia.com).norm(), 1e-15);
-    EXPECT_LT((back.model.bodies[b].inertia.inertia_com - perturbed.bodies[b].inertia.inertia_com).norm(), 1e-15);
+    EXPECT_LT(
+        (back.model.bodies[b].inertia.inertia_com - perturbed.bodies[b].inertia.inertia_com).norm(),
+        1e-15);
   }
   EXPECT_TRUE(back.model.find_frame("sensor").has_value());
   EXPECT_EQ(back.geometry.shapes.size(), robot_->geometry.shapes.size());
@@ -326,7 +356,8 @@ TEST_F(Replay, WrittenUrdfLoadsBackToTheSameDynamics) {
   Data a(perturbed), b(back.model);
   test::SeededRng rng(2);
   for (int k = 0; k < 10; ++k) {
-    const VectorX q = rng.uniform_vector(7, -2, 2), dq = rng.uniform_vector(7, -1, 1), ddq = rng.uniform_vector(7, -1, 1);
+    const VectorX q = rng.uniform_vector(7, -2, 2), dq = rng.uniform_vector(7, -1, 1),
+                  ddq = rng.uniform_vector(7, -1, 1);
     const VectorX ta = rnea(perturbed, a, q, dq, ddq);
     const VectorX tb = rnea(back.model, b, q, dq, ddq);
     EXPECT_LT((ta - tb).cwiseAbs().maxCoeff(), 1e-12);
@@ -343,9 +374,10 @@ int run(const std::string& command) {
 
 TEST_F(Replay, EstimateFedOnlyTheWrittenFilesReproducesSimulateByteForByte) {
   const fs::path dir = temp_dir("reproduce");
-  std::string scenario = replace(kGoodScenario, "ft: {sensor: {type: ft}, contact: {model: pure_force}}",
-                                 "ft: {sensor: {type: ft}, contact: {model: pure_force}}\n"
-                                 "  no_sensor: {sensor: {type: none}, contact: {model: pure_force}}");
+  std::string scenario =
+      replace(kGoodScenario, "ft: {sensor: {type: ft}, contact: {model: pure_force}}",
+              "ft: {sensor: {type: ft}, contact: {model: pure_force}}\n"
+              "  no_sensor: {sensor: {type: none}, contact: {model: pure_force}}");
   write_file(dir / "s.yaml", scenario);
   ASSERT_EQ(run(std::string(EXTWRENCH_CLI) + " simulate " + (dir / "s.yaml").string() + " --out " +
                 (dir / "sim").string() + " --no-figures > " + (dir / "sim.txt").string() + " 2>&1"),
@@ -358,9 +390,9 @@ TEST_F(Replay, EstimateFedOnlyTheWrittenFilesReproducesSimulateByteForByte) {
     fs::copy_file(dir / "sim" / "log.csv", iso / "log.csv");
     fs::copy_file(dir / "sim" / "model_estimator.urdf", iso / "model_estimator.urdf");
     fs::copy_file(dir / "sim" / scheme / "config.yaml", iso / scheme / "config.yaml");
-    ASSERT_EQ(run(std::string(EXTWRENCH_CLI) + " estimate --config " + (iso / scheme / "config.yaml").string() +
-                  " --log " + (iso / "log.csv").string() + " --out " + (iso / "out").string() +
-                  " --no-figures > /dev/null 2>&1"),
+    ASSERT_EQ(run(std::string(EXTWRENCH_CLI) + " estimate --config " +
+                  (iso / scheme / "config.yaml").string() + " --log " + (iso / "log.csv").string() +
+                  " --out " + (iso / "out").string() + " --no-figures > /dev/null 2>&1"),
               0);
     const std::string a = read_file(dir / "sim" / scheme / "estimates.csv");
     const std::string b = read_file(iso / "out" / "estimates.csv");
@@ -372,11 +404,12 @@ TEST_F(Replay, EstimateFedOnlyTheWrittenFilesReproducesSimulateByteForByte) {
 TEST_F(Replay, CommandLineErrorsExitWithTheDocumentedCodes) {
   const fs::path dir = temp_dir("cli");
   write_file(dir / "bad.yaml", kGoodScenario + "colour: red\n");
-  EXPECT_EQ(run(std::string(EXTWRENCH_CLI) + " simulate " + (dir / "bad.yaml").string() + " --out " +
-                (dir / "o").string() + " > " + (dir / "err.txt").string() + " 2>&1"),
+  EXPECT_EQ(run(std::string(EXTWRENCH_CLI) + " simulate " + (dir / "bad.yaml").string() +
+                " --out " + (dir / "o").string() + " > " + (dir / "err.txt").string() + " 2>&1"),
             1);
   EXPECT_NE(read_file(dir / "err.txt").find("colour: unknown key"), std::string::npos);
-  EXPECT_EQ(run(std::string(EXTWRENCH_CLI) + " estimate --config x.yaml --log y.csv --out z --exclude 3:1 > " +
+  EXPECT_EQ(run(std::string(EXTWRENCH_CLI) +
+                " estimate --config x.yaml --log y.csv --out z --exclude 3:1 > " +
                 (dir / "err2.txt").string() + " 2>&1"),
             2);
   EXPECT_NE(read_file(dir / "err2.txt").find("--exclude: expected FROM:TO"), std::string::npos);
@@ -417,7 +450,8 @@ TEST_F(Replay, PaperScenarioMeetsTheAcceptanceOverFiveSeeds) {
 /// Writes a log of `rows` rows at 1 kHz (7 joints, F/T sensor, truth) quickly: smooth synthetic
 /// signals, not a simulation (the estimator's numbers do not matter here, its memory does).
 void write_synthetic_log(const fs::path& path, long rows) {
-  LogLayout layout{.n = 7, .velocity = true, .force = true, .moment = true, .truth = true, .true_tau_ext = true};
+  LogLayout layout{
+      .n = 7, .velocity = true, .force = true, .moment = true, .truth = true, .true_tau_ext = true};
   LogWriter w(path, layout);
   sim::Sample s;
   s.q.resize(7);
@@ -448,7 +482,8 @@ long peak_rss_kb_of(const std::string& args) {
     const int null = ::open("/dev/null", O_WRONLY);
     dup2(null, 1);
     dup2(null, 2);
-    execl("/bin/sh", "sh", "-c", (std::string("exec ") + EXTWRENCH_CLI + " " + args).c_str(), nullptr);
+    execl("/bin/sh", "sh", "-c", (std::string("exec ") + EXTWRENCH_CLI + " " + args).c_str(),
+          nullptr);
     _exit(127);
   }
   int status = 0;
@@ -473,10 +508,12 @@ TEST_F(Replay, LongLogReplaysInTheMemoryOfAShortOne) {
   write_synthetic_log(dir / "long.csv", big_rows);
   write_file(dir / "config.yaml", "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
   const std::string common = " --config " + (dir / "config.yaml").string();
-  const long short_kb = peak_rss_kb_of("estimate" + common + " --log " + (dir / "short.csv").string() + " --out " +
-                                       (dir / "out_short").string());
-  const long long_kb = peak_rss_kb_of("estimate" + common + " --log " + (dir / "long.csv").string() + " --out " +
-                                      (dir / "out_long").string());
+  const long short_kb =
+      peak_rss_kb_of("estimate" + common + " --log " + (dir / "short.csv").string() + " --out " +
+                     (dir / "out_short").string());
+  const long long_kb =
+      peak_rss_kb_of("estimate" + common + " --log " + (dir / "long.csv").string() + " --out " +
+                     (dir / "out_long").string());
   RecordProperty("short_rss_kb", std::to_string(short_kb));
   RecordProperty("long_rss_kb", std::to_string(long_kb));
   std::printf("peak RSS: 60000 rows %ld kB, %ld rows %ld kB\n", short_kb, big_rows, long_kb);

@@ -2,6 +2,7 @@
 // Checked against the plain loop it replaced, run here on one thread: the same bytes in
 // estimates.csv, the same error text after the same rows, however the rows fall in batches.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +12,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <unistd.h>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/log.hpp"
@@ -34,7 +33,8 @@ class ReplayPipeline : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     robot_ = std::make_unique<RobotDescription>(load_robot(kPaperArm));
-    dir_ = fs::temp_directory_path() / ("extwrench_test_replay_pipeline_" + std::to_string(::getpid()));
+    dir_ = fs::temp_directory_path() /
+           ("extwrench_test_replay_pipeline_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -64,7 +64,12 @@ void write_file(const fs::path& path, const std::string& text) {
 /// A log of `rows` rows at 1 kHz: smooth joint motion, a noisy F/T reading, a push on link 6
 /// from row 300 (so the estimates go through free, pending and contact).
 void write_log(const fs::path& path, long rows, bool velocity) {
-  LogLayout layout{.n = 7, .velocity = velocity, .force = true, .moment = true, .truth = true, .true_tau_ext = false};
+  LogLayout layout{.n = 7,
+                   .velocity = velocity,
+                   .force = true,
+                   .moment = true,
+                   .truth = true,
+                   .true_tau_ext = false};
   LogWriter w(path, layout);
   test::SeededRng rng(11);
   sim::Sample s;
@@ -80,8 +85,9 @@ void write_log(const fs::path& path, long rows, bool velocity) {
     }
     s.t = t;
     const bool push = k >= 300;
-    s.sensor << rng.uniform(-1, 1) + (push ? 15.0 : 0.0), rng.uniform(-1, 1), -170 + rng.uniform(-1, 1),
-        rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1) + (push ? 6.0 : 0.0), rng.uniform(-0.1, 0.1);
+    s.sensor << rng.uniform(-1, 1) + (push ? 15.0 : 0.0), rng.uniform(-1, 1),
+        -170 + rng.uniform(-1, 1), rng.uniform(-0.1, 0.1),
+        rng.uniform(-0.1, 0.1) + (push ? 6.0 : 0.0), rng.uniform(-0.1, 0.1);
     s.truth.link = push ? "link6" : "";
     s.truth.body = push ? 6 : -1;
     s.truth.force << (push ? 15.0 : 0.0), 0, 0;
@@ -122,8 +128,8 @@ struct Outcome {
 
 /// The loop replay_log ran before it was split into threads: one row read, estimated and
 /// written after the other, on the calling thread.
-Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& options, const fs::path& log,
-                   const fs::path& out_dir) {
+Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& options,
+                   const fs::path& log, const fs::path& out_dir) {
   fs::create_directories(out_dir);
   Outcome o;
   try {
@@ -142,8 +148,9 @@ Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& option
         started = first.status.ok();
         writer.write(first);
       } else {
-        (void)(options.sensor.type == SensorType::kNone ? estimator.update(s.t, s.q, s.dq, s.tau)
-                                                         : estimator.update(s.t, s.q, s.dq, s.tau, s.sensor));
+        (void)(options.sensor.type == SensorType::kNone
+                   ? estimator.update(s.t, s.q, s.dq, s.tau)
+                   : estimator.update(s.t, s.q, s.dq, s.tau, s.sensor));
         writer.write(estimator.result());
       }
     }
@@ -155,8 +162,8 @@ Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& option
   return o;
 }
 
-Outcome pipelined(const RobotDescription& robot, const EstimatorOptions& options, const fs::path& log,
-                  const fs::path& out_dir) {
+Outcome pipelined(const RobotDescription& robot, const EstimatorOptions& options,
+                  const fs::path& log, const fs::path& out_dir) {
   ReplayOptions ro;
   ro.log = log;
   ro.out_dir = out_dir;
@@ -172,7 +179,9 @@ Outcome pipelined(const RobotDescription& robot, const EstimatorOptions& options
   return o;
 }
 
-long lines_of(const std::string& text) { return static_cast<long>(std::count(text.begin(), text.end(), '\n')); }
+long lines_of(const std::string& text) {
+  return static_cast<long>(std::count(text.begin(), text.end(), '\n'));
+}
 
 EstimatorOptions ft_options() {
   EstimatorOptions options;
@@ -214,8 +223,8 @@ TEST_F(ReplayPipeline, MalformedRowFailsWithTheSameTextAfterTheSameRowsAsThePlai
   const fs::path good = dir_ / "good.csv";
   write_log(good, rows, true);
   struct Case {
-    long row;           // 0-based data row that is malformed
-    int cell;           // 0-based cell replaced
+    long row;  // 0-based data row that is malformed
+    int cell;  // 0-based cell replaced
     std::string value;
     std::string expected;  // part of the message
   };
@@ -224,7 +233,8 @@ TEST_F(ReplayPipeline, MalformedRowFailsWithTheSameTextAfterTheSameRowsAsThePlai
       {kBatch - 1, 2, "abc", ":1025: column 3 'q2': expected a number, got 'abc'"},
       {kBatch, 20, "", ":1026: column 21 'tau6': empty cell, expected a number"},
       {2 * kBatch + 5, 0, "0.001", ":2055: column 1 't': time must increase (0.001 after 2.05"},
-      {rows - 1, 28, "link9", ":4099: column 29 'true_link': 'link9' is not a link of robot 'paper_arm'"},
+      {rows - 1, 28, "link9",
+       ":4099: column 29 'true_link': 'link9' is not a link of robot 'paper_arm'"},
   };
   for (const Case& c : cases) {
     const std::string name = "bad_" + std::to_string(c.row);
@@ -247,9 +257,11 @@ TEST_F(ReplayPipeline, MalformedSecondRowOfALogWithoutVelocitiesFailsBeforeAnyRo
   write_log(good, 50, false);
   const fs::path log = dir_ / "no_dq_bad.csv";
   corrupt_row(good, log, 1, row_with_cell(good, 1, 3, "x"));
-  const Outcome expected = plain_loop(*robot_, EstimatorOptions{}, log, dir_ / "no_dq_bad" / "plain");
+  const Outcome expected =
+      plain_loop(*robot_, EstimatorOptions{}, log, dir_ / "no_dq_bad" / "plain");
   const Outcome got = pipelined(*robot_, EstimatorOptions{}, log, dir_ / "no_dq_bad" / "pipelined");
-  EXPECT_NE(got.error.find(":3: column 4 'q3': expected a number, got 'x'"), std::string::npos) << got.error;
+  EXPECT_NE(got.error.find(":3: column 4 'q3': expected a number, got 'x'"), std::string::npos)
+      << got.error;
   EXPECT_EQ(got.error, expected.error);
   EXPECT_EQ(lines_of(got.estimates), 1);
   EXPECT_TRUE(got.estimates == expected.estimates);

@@ -126,7 +126,8 @@ TEST(Simulator, TrueAccelerationSatisfiesInverseDynamicsWithTheExternalWrench) {
     ASSERT_TRUE(true_acceleration(model, forces, 0.0, q, dq, tau, ws));
     // RNEA with the wrenches (eqs. 7-12) at the simulated q̈ must give back τ.
     const VectorX tau_back = rnea(model, data, q, dq, ws.data.ddq, ws.wrenches);
-    EXPECT_LT((tau_back - tau).cwiseAbs().maxCoeff(), kAlgebraicTol * (1.0 + tau.cwiseAbs().maxCoeff()));
+    EXPECT_LT((tau_back - tau).cwiseAbs().maxCoeff(),
+              kAlgebraicTol * (1.0 + tau.cwiseAbs().maxCoeff()));
     // τ_ext from the point Jacobians equals the RNEA difference.
     const VectorX zero = VectorX::Zero(7);
     const VectorX free = rnea(model, data, q, dq, zero);
@@ -235,7 +236,8 @@ TEST(PerturbModel, EveryEntryStaysWithinTheFractionAndZerosStayZero) {
     const Inertia& a = model.bodies[i].inertia;
     const Inertia& b = p.bodies[i].inertia;
     EXPECT_LE(std::abs(b.mass - a.mass), 0.01 * a.mass);
-    for (int k = 0; k < 3; ++k) EXPECT_LE(std::abs(b.com[k] - a.com[k]), 0.01 * std::abs(a.com[k]) + 0.0);
+    for (int k = 0; k < 3; ++k)
+      EXPECT_LE(std::abs(b.com[k] - a.com[k]), 0.01 * std::abs(a.com[k]) + 0.0);
     EXPECT_LE((b.inertia_com - a.inertia_com).cwiseAbs().maxCoeff(),
               0.01 * a.inertia_com.cwiseAbs().maxCoeff());
     EXPECT_TRUE(b.inertia_com.isApprox(b.inertia_com.transpose(), 0.0));
@@ -348,8 +350,12 @@ TEST(Simulator, BaseReadingEqualsWeightPlusForceForARobotHeldAtRest) {
 
 TEST(Metrics, AccumulatesErrorsInsideTheWindowOnly) {
   MetricsAccumulator acc(MetricsWindow{.from = 1.0, .to = 3.0, .exclude = {{1.5, 2.0}}});
-  TruthSample truth{.contact = true, .body = 4, .contacts = 1, .force = Vector3(10, 0, 0),
-                    .moment = Vector3::Zero(), .point = Vector3(0, 0, 1)};
+  TruthSample truth{.contact = true,
+                    .body = 4,
+                    .contacts = 1,
+                    .force = Vector3(10, 0, 0),
+                    .moment = Vector3::Zero(),
+                    .point = Vector3(0, 0, 1)};
   EstimateSample est;
   est.contact = true;
   est.body = 4;
@@ -377,8 +383,12 @@ TEST(Metrics, AccumulatesErrorsInsideTheWindowOnly) {
 TEST(Metrics, CountsFalseAlarmsMissesAndDetectionDelay) {
   MetricsAccumulator acc(MetricsWindow{});
   TruthSample free_truth;
-  TruthSample contact{.contact = true, .body = 2, .contacts = 1, .force = Vector3(0, 0, 3),
-                      .moment = Vector3::Zero(), .point = Vector3::Zero()};
+  TruthSample contact{.contact = true,
+                      .body = 2,
+                      .contacts = 1,
+                      .force = Vector3(0, 0, 3),
+                      .moment = Vector3::Zero(),
+                      .point = Vector3::Zero()};
   EstimateSample none, alarm;
   alarm.contact = true;
   alarm.body = 2;

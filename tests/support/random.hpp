@@ -10,13 +10,17 @@ namespace extwrench::test {
 class SeededRng {
  public:
   explicit SeededRng(unsigned seed) : engine_(seed) {}
-  double uniform(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(engine_); }
+  double uniform(double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(engine_);
+  }
   VectorX uniform_vector(int n, double lo, double hi) {
     VectorX v(n);
     for (int i = 0; i < n; ++i) v[i] = uniform(lo, hi);
     return v;
   }
-  Vector3 uniform_vector3(double lo, double hi) { return {uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)}; }
+  Vector3 uniform_vector3(double lo, double hi) {
+    return {uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)};
+  }
   std::mt19937& engine() { return engine_; }
 
  private:

@@ -9,8 +9,8 @@ namespace extwrench::test {
 
 struct RandomModelOptions {
   int n = 7;
-  bool tree = false;        ///< random parents instead of a chain
-  bool prismatic = false;   ///< some joints prismatic
+  bool tree = false;       ///< random parents instead of a chain
+  bool prismatic = false;  ///< some joints prismatic
   unsigned seed = 1;
 };
 

@@ -42,7 +42,8 @@ void append(std::vector<double>& out, const Eigen::DenseBase<Derived>& x) {
 }
 
 /// Runs `work` on kThreads threads started together; returns each thread's output.
-std::vector<std::vector<double>> run_concurrently(const std::function<std::vector<double>()>& work) {
+std::vector<std::vector<double>> run_concurrently(
+    const std::function<std::vector<double>()>& work) {
   std::vector<std::vector<double>> outputs(kThreads);
   std::latch start(kThreads);
   std::vector<std::thread> threads;
@@ -125,8 +126,8 @@ TEST(Threading, OneMomentumObserverPerThreadMatchesSingleThreadedBitForBit) {
 // base RNEA, isolation, case C, the line meeting the link's shapes). The robot description —
 // Panda meshes and their ray casters included when /work/shared is present — is shared const;
 // each thread builds its own ContactEstimator from it.
-void expect_estimators_match(const RobotDescription& robot, int contact_body, const Vector3& point_B,
-                             const Vector3& force_B) {
+void expect_estimators_match(const RobotDescription& robot, int contact_body,
+                             const Vector3& point_B, const Vector3& force_B) {
   const Model& model = robot.model;
   const int n = model.nq();
   // A smooth motion with a constant push on `contact_body`; τ and the base reading from RNEA.
@@ -161,7 +162,8 @@ void expect_estimators_match(const RobotDescription& robot, int contact_body, co
     std::vector<double> out;
     EXPECT_TRUE(estimator.reset(0.0, q[0], dq[0], tau[0]).ok());
     for (std::size_t k = 1; k < q.size(); ++k) {
-      EXPECT_TRUE(estimator.update(static_cast<double>(k) * 1e-3, q[k], dq[k], tau[k], reading[k]).ok());
+      EXPECT_TRUE(
+          estimator.update(static_cast<double>(k) * 1e-3, q[k], dq[k], tau[k], reading[k]).ok());
       const ContactEstimate& e = estimator.result();
       out.push_back(e.link);
       out.push_back(e.flags);
@@ -172,7 +174,8 @@ void expect_estimators_match(const RobotDescription& robot, int contact_body, co
     }
     // Last: did the run exercise the full path (contact declared on the right link, a point)?
     const ContactEstimate& last = estimator.result();
-    out.push_back(last.contact && last.link == contact_body && last.has(EstimateFlag::kLineOfAction));
+    out.push_back(last.contact && last.link == contact_body &&
+                  last.has(EstimateFlag::kLineOfAction));
     return out;
   };
   const std::vector<double> reference = work();
@@ -190,7 +193,8 @@ TEST(Threading, OneContactEstimatorPerThreadOnSharedCapsulesMatchesSingleThreade
 }
 
 TEST(Threading, OneContactEstimatorPerThreadOnSharedPandaMeshesMatchesSingleThreaded) {
-  const std::filesystem::path urdf = std::filesystem::path(EXTWRENCH_SHARED_DIR) /
+  const std::filesystem::path urdf =
+      std::filesystem::path(EXTWRENCH_SHARED_DIR) /
       "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
   if (!std::filesystem::exists(urdf)) GTEST_SKIP() << "no " << urdf;
   RobotDescription panda = load_robot(urdf);
@@ -204,7 +208,8 @@ TEST(Threading, OneContactEstimatorPerThreadOnSharedPandaMeshesMatchesSingleThre
   g.body_shapes.resize(static_cast<std::size_t>(keep));
   for (const CollisionShape& shape : panda.geometry.shapes) {
     if (shape.body >= keep) continue;
-    g.body_shapes[static_cast<std::size_t>(shape.body)].push_back(static_cast<int>(g.shapes.size()));
+    g.body_shapes[static_cast<std::size_t>(shape.body)].push_back(
+        static_cast<int>(g.shapes.size()));
     g.shapes.push_back(shape);
   }
   panda.geometry = std::move(g);

@@ -11,16 +11,24 @@ namespace extwrench {
 enum class StatusCode : std::uint8_t {
   kOk = 0,
   // Input errors: nothing was changed.
-  kWrongSize,           ///< an input vector has the wrong size
-  kNonFinite,           ///< NaN or Inf in an input
-  kNonIncreasingTime,   ///< the time stamp did not increase
-  kNotInitialized,      ///< reset() was not called
+  kWrongSize,          ///< an input vector has the wrong size
+  kNonFinite,          ///< NaN or Inf in an input
+  kNonIncreasingTime,  ///< the time stamp did not increase
+  kNotInitialized,     ///< reset() was not called
   // Numerical outcomes.
-  kSingular,            ///< a matrix could not be factored
+  kSingular,  ///< a matrix could not be factored
 };
 
 /// Which input channel a Status refers to (for kWrongSize / kNonFinite).
-enum class Channel : std::uint8_t { kNone, kTime, kPosition, kVelocity, kTorque, kAcceleration, kBaseWrench };
+enum class Channel : std::uint8_t {
+  kNone,
+  kTime,
+  kPosition,
+  kVelocity,
+  kTorque,
+  kAcceleration,
+  kBaseWrench
+};
 
 struct Status {
   StatusCode code = StatusCode::kOk;
@@ -33,25 +41,38 @@ struct Status {
 
 constexpr std::string_view to_string(StatusCode c) noexcept {
   switch (c) {
-    case StatusCode::kOk: return "ok";
-    case StatusCode::kWrongSize: return "wrong_size";
-    case StatusCode::kNonFinite: return "non_finite";
-    case StatusCode::kNonIncreasingTime: return "non_increasing_time";
-    case StatusCode::kNotInitialized: return "not_initialized";
-    case StatusCode::kSingular: return "singular";
+    case StatusCode::kOk:
+      return "ok";
+    case StatusCode::kWrongSize:
+      return "wrong_size";
+    case StatusCode::kNonFinite:
+      return "non_finite";
+    case StatusCode::kNonIncreasingTime:
+      return "non_increasing_time";
+    case StatusCode::kNotInitialized:
+      return "not_initialized";
+    case StatusCode::kSingular:
+      return "singular";
   }
   return "unknown";
 }
 
 constexpr std::string_view to_string(Channel c) noexcept {
   switch (c) {
-    case Channel::kNone: return "none";
-    case Channel::kTime: return "t";
-    case Channel::kPosition: return "q";
-    case Channel::kVelocity: return "dq";
-    case Channel::kTorque: return "tau";
-    case Channel::kAcceleration: return "ddq";
-    case Channel::kBaseWrench: return "base_wrench";
+    case Channel::kNone:
+      return "none";
+    case Channel::kTime:
+      return "t";
+    case Channel::kPosition:
+      return "q";
+    case Channel::kVelocity:
+      return "dq";
+    case Channel::kTorque:
+      return "tau";
+    case Channel::kAcceleration:
+      return "ddq";
+    case Channel::kBaseWrench:
+      return "base_wrench";
   }
   return "unknown";
 }

@@ -7,10 +7,9 @@
 //    world origin, unless their name says otherwise.
 #pragma once
 
-#include <cmath>
-
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 
 namespace extwrench {
 
@@ -33,7 +32,7 @@ inline Matrix3 skew(const Vector3& v) {
 /// Rigid transform X_AB (pose of frame B in frame A).
 struct Pose {
   Matrix3 rotation = Matrix3::Identity();  ///< R_AB
-  Vector3 translation = Vector3::Zero();    ///< p_AB: origin of B in A
+  Vector3 translation = Vector3::Zero();   ///< p_AB: origin of B in A
 
   static Pose identity() { return {}; }
 

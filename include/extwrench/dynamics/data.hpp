@@ -2,10 +2,9 @@
 // that no algorithm allocates afterwards. One Data per thread; the Model is shared (const).
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <array>
 #include <vector>
-
-#include <Eigen/Cholesky>
 
 #include "extwrench/model/model.hpp"
 
@@ -29,30 +28,31 @@ struct Data {
   std::vector<double> axis_sign;
 
   // --- forward kinematics (forward_kinematics) ---
-  std::vector<Pose> X_WB;           ///< pose of each body frame in the world
-  std::vector<Vector6> S;           ///< joint motion subspace of body i's joint (world, at origin)
+  std::vector<Pose> X_WB;  ///< pose of each body frame in the world
+  std::vector<Vector6> S;  ///< joint motion subspace of body i's joint (world, at origin)
   // World-frame mass properties, about the world origin: m, h = m c_W, I_O.
-  std::vector<double> mass;         ///< m_i (copy, so the hot path reads one array)
-  std::vector<Vector3> first_moment_W;   ///< h_i = m_i c_i (world)
+  std::vector<double> mass;             ///< m_i (copy, so the hot path reads one array)
+  std::vector<Vector3> first_moment_W;  ///< h_i = m_i c_i (world)
   std::vector<Matrix3> inertia_O_W;     ///< rotational inertia about the world origin
 
   // --- velocities / accelerations / forces (rnea & co.) ---
-  std::vector<Vector6> v;           ///< spatial velocity of body i
-  std::vector<Vector6> a;           ///< spatial acceleration of body i (gravity trick included)
-  std::vector<Vector6> f;           ///< spatial force transmitted by joint i to body i (f_i)
-  std::vector<Vector6> h;           ///< spatial momentum of body i (I_i v_i)
-  std::vector<Vector6> bias_f;      ///< scratch of momentum_and_bias_terms: bias wrench of each subtree
+  std::vector<Vector6> v;       ///< spatial velocity of body i
+  std::vector<Vector6> a;       ///< spatial acceleration of body i (gravity trick included)
+  std::vector<Vector6> f;       ///< spatial force transmitted by joint i to body i (f_i)
+  std::vector<Vector6> h;       ///< spatial momentum of body i (I_i v_i)
+  std::vector<Vector6> bias_f;  ///< scratch of momentum_and_bias_terms: bias wrench of each subtree
 
   // --- results ---
-  VectorX tau;                      ///< (n) joint torques of the last rnea / bias / gravity
-  Vector6 root_wrench_W = Vector6::Zero();  ///< f_0: wrench the ground applies to link 0, world, about the world origin
-  MatrixX M;                        ///< (n x n) mass matrix B(q), both triangles filled
-  MatrixX C;                        ///< (n x n) Coriolis matrix with B_dot = C + C^T
-  VectorX momentum;                 ///< (n) generalized momentum B(q) q_dot
-  VectorX coriolis_transpose_dq;    ///< (n) C^T(q, q_dot) q_dot = dT/dq
-  VectorX gravity_torque;           ///< (n) g(q)
-  VectorX ddq;                      ///< (n) result of forward_dynamics
-  Matrix6X J;                       ///< (6 x n) last Jacobian computed
+  VectorX tau;  ///< (n) joint torques of the last rnea / bias / gravity
+  Vector6 root_wrench_W =
+      Vector6::Zero();  ///< f_0: wrench the ground applies to link 0, world, about the world origin
+  MatrixX M;            ///< (n x n) mass matrix B(q), both triangles filled
+  MatrixX C;            ///< (n x n) Coriolis matrix with B_dot = C + C^T
+  VectorX momentum;     ///< (n) generalized momentum B(q) q_dot
+  VectorX coriolis_transpose_dq;  ///< (n) C^T(q, q_dot) q_dot = dT/dq
+  VectorX gravity_torque;         ///< (n) g(q)
+  VectorX ddq;                    ///< (n) result of forward_dynamics
+  Matrix6X J;                     ///< (6 x n) last Jacobian computed
 
   // --- scratch ---
   // Composite mass properties of each subtree about the world origin: (m, h, I_O) add up
@@ -60,11 +60,11 @@ struct Data {
   std::vector<double> composite_mass;
   std::vector<Vector3> composite_first_moment;
   std::vector<Matrix3> composite_inertia_O;
-  std::vector<Matrix6> Ic;          ///< composite spatial inertia of each subtree (world, origin)
-  std::vector<Matrix6> Bc;          ///< composite v x* I of each subtree (for C)
-  std::vector<Vector6> Sdot;        ///< time derivative of S
-  VectorX tmp_n;                    ///< (n) scratch
-  Eigen::LLT<MatrixX> mass_llt;     ///< factorization of M, sized once
+  std::vector<Matrix6> Ic;       ///< composite spatial inertia of each subtree (world, origin)
+  std::vector<Matrix6> Bc;       ///< composite v x* I of each subtree (for C)
+  std::vector<Vector6> Sdot;     ///< time derivative of S
+  VectorX tmp_n;                 ///< (n) scratch
+  Eigen::LLT<MatrixX> mass_llt;  ///< factorization of M, sized once
 };
 
 }  // namespace extwrench

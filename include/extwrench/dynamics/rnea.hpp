@@ -10,10 +10,10 @@ namespace extwrench {
 /// An external wrench acting on a body: a force applied at a point plus a pure moment,
 /// all in the world frame.
 struct ExternalWrench {
-  int body = 0;                      ///< index of the body it acts on (0 = link 0)
-  Vector3 force_W = Vector3::Zero(); ///< F_ext [N]
-  Vector3 point_W = Vector3::Zero(); ///< application point p [m]
-  Vector3 moment_W = Vector3::Zero();///< pure moment M_ext [N m]
+  int body = 0;                        ///< index of the body it acts on (0 = link 0)
+  Vector3 force_W = Vector3::Zero();   ///< F_ext [N]
+  Vector3 point_W = Vector3::Zero();   ///< application point p [m]
+  Vector3 moment_W = Vector3::Zero();  ///< pure moment M_ext [N m]
 };
 
 /// Inverse dynamics tau = B(q) ddq + C(q, dq) dq + g(q) - sum_k J_k^T W_k, eqs. (7)-(12),

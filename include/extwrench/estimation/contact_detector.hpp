@@ -15,17 +15,18 @@ namespace extwrench {
 
 struct DetectionOptions {
   VectorX tau_min = VectorX::Constant(1, 1.0);  ///< τ_min [N m | N]: size 1 (all joints) or n
-  double f_min = 5.0;            ///< F_min on ‖F̂_ext‖ from the base sensor [N]
-  double release_ratio = 0.5;    ///< off level = ratio × on level, in (0, 1]
-  double min_duration = 0.005;   ///< [s] ≥ 0, for both onset and release
+  double f_min = 5.0;                           ///< F_min on ‖F̂_ext‖ from the base sensor [N]
+  double release_ratio = 0.5;                   ///< off level = ratio × on level, in (0, 1]
+  double min_duration = 0.005;                  ///< [s] ≥ 0, for both onset and release
 };
 
 struct DetectionResult {
   bool contact = false;  ///< declared contact
-  bool pending = false;  ///< raw detection on, contact not (yet) declared, or raw off while declared
-  bool raw = false;      ///< some joint or the base force is over its threshold now
+  bool pending =
+      false;         ///< raw detection on, contact not (yet) declared, or raw off while declared
+  bool raw = false;  ///< some joint or the base force is over its threshold now
   bool base_only = false;  ///< raw detection by the base force only
-  int link = -1;         ///< isolated link while `contact` (0 = link 0), −1 otherwise
+  int link = -1;           ///< isolated link while `contact` (0 = link 0), −1 otherwise
 };
 
 class ContactDetector {
@@ -44,12 +45,12 @@ class ContactDetector {
 
  private:
   DetectionOptions options_;
-  VectorX tau_min_;               ///< (n)
+  VectorX tau_min_;  ///< (n)
   Eigen::Matrix<bool, Eigen::Dynamic, 1> joint_over_;
   bool base_over_ = false;
   bool declared_ = false;
-  bool have_edge_ = false;        ///< edge_time_ is valid
-  double edge_time_ = 0.0;        ///< when the raw detection last changed against `declared_`
+  bool have_edge_ = false;  ///< edge_time_ is valid
+  double edge_time_ = 0.0;  ///< when the raw detection last changed against `declared_`
   int last_link_ = -1;
   DetectionResult result_;
 };

@@ -26,7 +26,7 @@ enum class ContactModel : std::uint8_t {
 
 /// Where q̈̂ and τ̂_ext come from (SPEC §2 (a), (b)).
 enum class AccelerationRoute : std::uint8_t {
-  kResidual,         ///< (b) τ̂_ext = r, q̈̂ = B⁻¹(τ − τ_f + r − c)
+  kResidual,  ///< (b) τ̂_ext = r, q̈̂ = B⁻¹(τ − τ_f + r − c)
   kDifferentiation,  ///< (a) q̈̂ = low-passed difference of q̇, τ̂_ext = RNEA(q, q̇, q̈̂) + τ_f − τ
 };
 
@@ -36,21 +36,31 @@ enum class AccelerationRoute : std::uint8_t {
 
 /// Bits of ContactEstimate::flags: what was estimated and how far to trust it.
 struct EstimateFlag {
-  static constexpr std::uint32_t kContact = 1u << 0;          ///< a contact is declared
-  static constexpr std::uint32_t kPending = 1u << 1;          ///< over threshold, not yet for min_duration
-  static constexpr std::uint32_t kForce = 1u << 2;            ///< force_W estimated
-  static constexpr std::uint32_t kMoment = 1u << 3;           ///< moment_W estimated
-  static constexpr std::uint32_t kLineOfAction = 1u << 4;     ///< line_point_W / line_direction_W estimated
-  static constexpr std::uint32_t kSurfacePoint = 1u << 5;     ///< point_* is the line's entry on the link surface
-  static constexpr std::uint32_t kSurfaceMissed = 1u << 6;    ///< the line misses the link: point_* is the nearest surface point
-  static constexpr std::uint32_t kKnownPoint = 1u << 7;       ///< point_* is the configured contact point
-  static constexpr std::uint32_t kNoGeometry = 1u << 8;       ///< the link has no collision shape: no surface point
-  static constexpr std::uint32_t kIllConditioned = 1u << 9;   ///< condition number over the limit: damped least squares
-  static constexpr std::uint32_t kUnobservable = 1u << 10;    ///< rank too low for moment / point (or force): not estimated
-  static constexpr std::uint32_t kDisagreement = 1u << 11;    ///< base wrench and residual inconsistent (e.g. two contacts)
-  static constexpr std::uint32_t kBaseOnly = 1u << 12;        ///< seen by the base sensor only: link 0
-  static constexpr std::uint32_t kTaring = 1u << 13;          ///< sensor bias being estimated: sensor detection off
-  static constexpr std::uint32_t kLinkMismatch = 1u << 14;    ///< known-point link differs from the isolated link
+  static constexpr std::uint32_t kContact = 1u << 0;  ///< a contact is declared
+  static constexpr std::uint32_t kPending = 1u << 1;  ///< over threshold, not yet for min_duration
+  static constexpr std::uint32_t kForce = 1u << 2;    ///< force_W estimated
+  static constexpr std::uint32_t kMoment = 1u << 3;   ///< moment_W estimated
+  static constexpr std::uint32_t kLineOfAction =
+      1u << 4;  ///< line_point_W / line_direction_W estimated
+  static constexpr std::uint32_t kSurfacePoint =
+      1u << 5;  ///< point_* is the line's entry on the link surface
+  static constexpr std::uint32_t kSurfaceMissed =
+      1u << 6;  ///< the line misses the link: point_* is the nearest surface point
+  static constexpr std::uint32_t kKnownPoint = 1u
+                                               << 7;  ///< point_* is the configured contact point
+  static constexpr std::uint32_t kNoGeometry =
+      1u << 8;  ///< the link has no collision shape: no surface point
+  static constexpr std::uint32_t kIllConditioned =
+      1u << 9;  ///< condition number over the limit: damped least squares
+  static constexpr std::uint32_t kUnobservable =
+      1u << 10;  ///< rank too low for moment / point (or force): not estimated
+  static constexpr std::uint32_t kDisagreement =
+      1u << 11;  ///< base wrench and residual inconsistent (e.g. two contacts)
+  static constexpr std::uint32_t kBaseOnly = 1u << 12;  ///< seen by the base sensor only: link 0
+  static constexpr std::uint32_t kTaring =
+      1u << 13;  ///< sensor bias being estimated: sensor detection off
+  static constexpr std::uint32_t kLinkMismatch =
+      1u << 14;  ///< known-point link differs from the isolated link
 };
 
 /// Names of the set bits, separated by '|' ("contact|force|line|surface_point"); "free" for 0.
@@ -61,21 +71,25 @@ struct EstimateFlag {
 struct ContactEstimate {
   static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-  double t = kNaN;                  ///< time stamp of the sample [s]
-  bool contact = false;             ///< a contact is declared (detection with hysteresis and min_duration)
-  int link = -1;                    ///< contact link (body index, 0 = link 0); −1 when none
-  std::string_view link_name;       ///< name of that body (views the estimator's model); empty when none
-  Vector3 force_W = Vector3::Constant(kNaN);    ///< F̂_ext [N]
-  Vector3 moment_W = Vector3::Constant(kNaN);   ///< M̂_ext [N m], pure moment besides the force at the point (known point)
-  Vector3 point_W = Vector3::Constant(kNaN);    ///< contact point: surface point (pure force) or configured point [m]
-  Vector3 point_L = Vector3::Constant(kNaN);    ///< the same in the link's frame [m]
-  Vector3 line_point_W = Vector3::Constant(kNaN);      ///< p̂ of eq. (20): point of the line nearest O_l [m]
+  double t = kNaN;       ///< time stamp of the sample [s]
+  bool contact = false;  ///< a contact is declared (detection with hysteresis and min_duration)
+  int link = -1;         ///< contact link (body index, 0 = link 0); −1 when none
+  std::string_view link_name;  ///< name of that body (views the estimator's model); empty when none
+  Vector3 force_W = Vector3::Constant(kNaN);  ///< F̂_ext [N]
+  Vector3 moment_W = Vector3::Constant(
+      kNaN);  ///< M̂_ext [N m], pure moment besides the force at the point (known point)
+  Vector3 point_W = Vector3::Constant(
+      kNaN);  ///< contact point: surface point (pure force) or configured point [m]
+  Vector3 point_L = Vector3::Constant(kNaN);  ///< the same in the link's frame [m]
+  Vector3 line_point_W =
+      Vector3::Constant(kNaN);  ///< p̂ of eq. (20): point of the line nearest O_l [m]
   Vector3 line_direction_W = Vector3::Constant(kNaN);  ///< unit F̂/‖F̂‖
-  double surface_distance = kNaN;   ///< 0 when the line meets the link; > 0 when it misses [m]
-  VectorX residual;                 ///< τ̂_ext (n) used for isolation: r, or RNEA − τ (differentiation route)
-  double condition_number = kNaN;   ///< σ_max/σ_min of the Jacobian inverted (cases D, E), SI units; NaN when none
-  Status status;                    ///< input errors; ok otherwise
-  std::uint32_t flags = 0;          ///< EstimateFlag bits
+  double surface_distance = kNaN;  ///< 0 when the line meets the link; > 0 when it misses [m]
+  VectorX residual;  ///< τ̂_ext (n) used for isolation: r, or RNEA − τ (differentiation route)
+  double condition_number =
+      kNaN;       ///< σ_max/σ_min of the Jacobian inverted (cases D, E), SI units; NaN when none
+  Status status;  ///< input errors; ok otherwise
+  std::uint32_t flags = 0;  ///< EstimateFlag bits
 
   [[nodiscard]] bool has(std::uint32_t flag) const noexcept { return (flags & flag) != 0; }
 };

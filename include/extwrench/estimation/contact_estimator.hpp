@@ -25,9 +25,8 @@
 // bit-identical results to a run that never saw the bad one).
 #pragma once
 
-#include <optional>
-
 #include <Eigen/Cholesky>
+#include <optional>
 
 #include "extwrench/estimation/contact_detector.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
@@ -38,23 +37,24 @@ namespace extwrench {
 
 struct SensorOptions {
   SensorType type = SensorType::kNone;
-  Pose pose;              ///< X_WS: pose of the sensor frame in the robot's root frame
-  int tare_samples = 0;   ///< > 0: bias = mean(reading − predicted) over the first samples after reset
+  Pose pose;  ///< X_WS: pose of the sensor frame in the robot's root frame
+  int tare_samples =
+      0;  ///< > 0: bias = mean(reading − predicted) over the first samples after reset
 };
 
 struct ContactOptions {
   ContactModel model = ContactModel::kPureForce;
-  int link = -1;                       ///< known point: body index of the contact link
-  Vector3 point = Vector3::Zero();     ///< known point: p in the link frame [m]
+  int link = -1;                    ///< known point: body index of the contact link
+  Vector3 point = Vector3::Zero();  ///< known point: p in the link frame [m]
 };
 
 struct PayloadOptions {
-  int body = -1;         ///< body carrying the payload
-  Inertia inertia;       ///< mass properties in that body's frame
+  int body = -1;    ///< body carrying the payload
+  Inertia inertia;  ///< mass properties in that body's frame
 };
 
 struct SolverOptions {
-  double max_condition = 1e3;     ///< κ above which damping starts (damped least squares)
+  double max_condition = 1e3;  ///< κ above which damping starts (damped least squares)
   /// σ_min/σ_max at or below which the rank is deficient. σ comes from the eigenvalues of J Jᵀ,
   /// accurate to ~1e-8 σ_max, so the tolerance must stay well above that.
   double rank_tolerance = 1e-6;
@@ -92,7 +92,8 @@ class ContactEstimator {
   /// a 3-axis sensor uses the first three entries only). Returns result().status.
   [[nodiscard]] Status update(double t, const Eigen::Ref<const VectorX>& q,
                               const Eigen::Ref<const VectorX>& dq,
-                              const Eigen::Ref<const VectorX>& tau, const Vector6& reading_S) noexcept;
+                              const Eigen::Ref<const VectorX>& tau,
+                              const Vector6& reading_S) noexcept;
   /// One sample without a base sensor (sensor type none).
   [[nodiscard]] Status update(double t, const Eigen::Ref<const VectorX>& q,
                               const Eigen::Ref<const VectorX>& dq,
@@ -129,8 +130,8 @@ class ContactEstimator {
  private:
   Status validate_reading(const Vector6& reading_S) const noexcept;
   Status validate_common(double t, const Eigen::Ref<const VectorX>& q,
-                         const Eigen::Ref<const VectorX>& dq,
-                         const Eigen::Ref<const VectorX>& tau, const Vector6& reading_S) const noexcept;
+                         const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau,
+                         const Vector6& reading_S) const noexcept;
   void fail(double t, Status s) noexcept;
   void estimate(double t, const Vector6& reading_S) noexcept;
   void locate_on_surface(int link) noexcept;
@@ -145,7 +146,7 @@ class ContactEstimator {
   // State besides the observer's.
   bool initialized_ = false;
   double t_ = 0.0;
-  VectorX dq_prev_, ddq_filtered_;   ///< route (a)
+  VectorX dq_prev_, ddq_filtered_;  ///< route (a)
   bool have_dq_prev_ = false;
   Vector6 bias_S_ = Vector6::Zero();
   Vector6 tare_sum_ = Vector6::Zero();

@@ -66,8 +66,8 @@ struct SurfacePointResult {
   /// Intersections over all shapes (2 for one convex shape). Past 32 crossings of one shape,
   /// coincident ones may be counted twice; entry and exit stay exact.
   int num_hits = 0;
-  LineHit entry;     ///< smallest λ: the pushing point (21)
-  LineHit exit;      ///< largest λ: the pulling point
+  LineHit entry;  ///< smallest λ: the pushing point (21)
+  LineHit exit;   ///< largest λ: the pulling point
   /// Hit: the entry point, distance 0. Miss: the surface point nearest to the line, with the
   /// line's λ there and the distance [m] (+inf if the body has no usable shape; NaN if the
   /// direction is zero or an input is not finite).

@@ -18,7 +18,7 @@ class MeshRayCaster;
 
 /// Triangle mesh in the shape frame (scale already applied).
 struct TriangleMesh {
-  std::string path;                          ///< file it was loaded from
+  std::string path;  ///< file it was loaded from
   Eigen::Matrix<double, 3, Eigen::Dynamic> vertices;
   Eigen::Matrix<int, 3, Eigen::Dynamic> triangles;  ///< vertex indices, counter-clockwise outward
   std::shared_ptr<const MeshRayCaster> ray_caster;  ///< may be null: brute force is used then
@@ -28,13 +28,13 @@ struct TriangleMesh {
 /// its origin (URDF convention); `length` excludes a capsule's hemispherical caps.
 struct CollisionShape {
   ShapeType type = ShapeType::kSphere;
-  std::string link;      ///< URDF link (frame) it was declared on
-  int body = 0;          ///< body it is rigidly attached to
-  Pose placement;        ///< X_{body, shape}
-  double radius = 0.0;   ///< sphere, cylinder, capsule [m]
-  double length = 0.0;   ///< cylinder, capsule [m]
-  Vector3 size = Vector3::Zero();   ///< box: full side lengths [m]
-  Vector3 scale = Vector3::Ones();  ///< mesh scale as declared
+  std::string link;                          ///< URDF link (frame) it was declared on
+  int body = 0;                              ///< body it is rigidly attached to
+  Pose placement;                            ///< X_{body, shape}
+  double radius = 0.0;                       ///< sphere, cylinder, capsule [m]
+  double length = 0.0;                       ///< cylinder, capsule [m]
+  Vector3 size = Vector3::Zero();            ///< box: full side lengths [m]
+  Vector3 scale = Vector3::Ones();           ///< mesh scale as declared
   std::shared_ptr<const TriangleMesh> mesh;  ///< kMesh only
 };
 

@@ -102,10 +102,10 @@ class CsvReader {
   std::size_t buffer_end_ = 0;
   bool eof_ = false;
 
-  std::string_view line_;              // the current line in buffer_ (CR stripped)
-  std::string unquoted_;               // storage for quoted cells with "" escapes
+  std::string_view line_;  // the current line in buffer_ (CR stripped)
+  std::string unquoted_;   // storage for quoted cells with "" escapes
   std::vector<std::string_view> cells_;
-  std::size_t next_line_ = 1;          // number of the next line to be read
+  std::size_t next_line_ = 1;  // number of the next line to be read
   std::size_t row_line_ = 0;
   std::size_t rows_read_ = 0;
 };
@@ -160,7 +160,7 @@ class CsvWriter {
   std::unique_ptr<char[]> buffer_;
   std::size_t capacity_ = 0;
   std::size_t size_ = 0;
-  std::size_t row_start_ = 0;     // where the current row begins in buffer_
+  std::size_t row_start_ = 0;  // where the current row begins in buffer_
   std::size_t cells_in_row_ = 0;
 };
 

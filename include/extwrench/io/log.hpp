@@ -18,12 +18,12 @@ namespace extwrench {
 
 /// Which optional column groups a log has.
 struct LogLayout {
-  int n = 0;                   ///< joints: q1..qn, (dq1..dqn), tau1..taun
-  bool velocity = true;        ///< dq1..dqn
-  bool force = false;          ///< fs_x fs_y fs_z
-  bool moment = false;         ///< ms_x ms_y ms_z (only with force)
-  bool truth = false;          ///< true_link, true_f*, true_m*, true_p*
-  bool true_tau_ext = false;   ///< true_tau_ext1..n
+  int n = 0;                  ///< joints: q1..qn, (dq1..dqn), tau1..taun
+  bool velocity = true;       ///< dq1..dqn
+  bool force = false;         ///< fs_x fs_y fs_z
+  bool moment = false;        ///< ms_x ms_y ms_z (only with force)
+  bool truth = false;         ///< true_link, true_f*, true_m*, true_p*
+  bool true_tau_ext = false;  ///< true_tau_ext1..n
 };
 
 /// The column names of a layout, in the order the writer uses.
@@ -57,7 +57,8 @@ class LogReader {
   LogLayout layout_;
   std::vector<std::string> ignored_;
   int col_t_ = -1;
-  std::vector<int> col_q_, col_dq_, col_tau_, col_fs_, col_ms_, col_f_, col_m_, col_p_, col_tau_ext_;
+  std::vector<int> col_q_, col_dq_, col_tau_, col_fs_, col_ms_, col_f_, col_m_, col_p_,
+      col_tau_ext_;
   int col_link_ = -1;
   bool have_prev_ = false;
   double prev_t_ = 0.0;

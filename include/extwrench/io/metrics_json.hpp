@@ -18,12 +18,12 @@ struct NamedMetrics {
 };
 
 struct MetricsReport {
-  std::string scheme;                   ///< scheme name (or the config's file name)
-  std::string log;                      ///< the log replayed
-  std::string config;                   ///< the estimator configuration
-  long rows = 0;                        ///< rows replayed
-  double t_begin = 0.0, t_end = 0.0;    ///< time span of the log [s]
-  bool surface_metrics = false;         ///< whether the surface-point error is meaningful
+  std::string scheme;                 ///< scheme name (or the config's file name)
+  std::string log;                    ///< the log replayed
+  std::string config;                 ///< the estimator configuration
+  long rows = 0;                      ///< rows replayed
+  double t_begin = 0.0, t_end = 0.0;  ///< time span of the log [s]
+  bool surface_metrics = false;       ///< whether the surface-point error is meaningful
   std::vector<std::pair<std::string, std::string>> notes;  ///< extra key → text
   std::vector<NamedMetrics> windows;
 };

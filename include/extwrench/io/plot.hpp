@@ -22,8 +22,12 @@ class Decimator {
   /// Skips the next row without offering it (when wants_next() was false).
   void skip() { ++index_; }
   [[nodiscard]] int width() const { return width_; }
-  [[nodiscard]] int rows() const { return static_cast<int>(data_.size() / static_cast<std::size_t>(width_)); }
-  [[nodiscard]] const double* row(int i) const { return data_.data() + static_cast<std::size_t>(i) * width_; }
+  [[nodiscard]] int rows() const {
+    return static_cast<int>(data_.size() / static_cast<std::size_t>(width_));
+  }
+  [[nodiscard]] const double* row(int i) const {
+    return data_.data() + static_cast<std::size_t>(i) * width_;
+  }
   /// Writes the rows as whitespace-separated text (NaN as "NaN", which gnuplot skips).
   void write(const std::filesystem::path& path) const;
 

@@ -22,23 +22,23 @@ struct ReplayWindow {
 
 struct ReplayOptions {
   std::filesystem::path log;
-  std::filesystem::path out_dir;        ///< estimates.csv, metrics.json, figures go here
-  std::string name;                     ///< run name in titles and the report (scheme)
-  std::string config_label;             ///< the configuration file, for the report
+  std::filesystem::path out_dir;  ///< estimates.csv, metrics.json, figures go here
+  std::string name;               ///< run name in titles and the report (scheme)
+  std::string config_label;       ///< the configuration file, for the report
   /// Metric windows; empty: one window over the whole log.
   std::vector<ReplayWindow> windows;
-  bool surface_metrics = false;         ///< report the surface-point error
+  bool surface_metrics = false;  ///< report the surface-point error
   bool figures = true;
-  int plot_points = 2000;               ///< decimation target per figure
-  int snapshots = 4;                    ///< instants of the 3-D view
-  bool progress = false;                ///< progress line on stderr
-  bool warn_ignored_columns = true;     ///< list unknown log columns once on stderr
+  int plot_points = 2000;            ///< decimation target per figure
+  int snapshots = 4;                 ///< instants of the 3-D view
+  bool progress = false;             ///< progress line on stderr
+  bool warn_ignored_columns = true;  ///< list unknown log columns once on stderr
 };
 
 struct ReplayResult {
   long rows = 0;
   bool has_truth = false;
-  MetricsReport report;                           ///< empty windows without truth
+  MetricsReport report;  ///< empty windows without truth
   std::vector<std::filesystem::path> figures;
 };
 

@@ -17,8 +17,8 @@ struct LoadOptions {
   /// each. ROS_PACKAGE_PATH (colon-separated) is appended when `use_ros_package_path`.
   std::vector<std::filesystem::path> package_path;
   bool use_ros_package_path = true;
-  bool load_meshes = true;        ///< false: mesh shapes are kept without triangles
-  std::optional<Vector3> gravity; ///< overrides the file's / default gravity
+  bool load_meshes = true;         ///< false: mesh shapes are kept without triangles
+  std::optional<Vector3> gravity;  ///< overrides the file's / default gravity
 };
 
 /// A robot: its dynamics model, its collision geometry, and where it came from.

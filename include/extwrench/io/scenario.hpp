@@ -18,8 +18,8 @@ namespace extwrench {
 
 struct SchemeSpec {
   std::string name;
-  std::string yaml;   ///< the scheme's configuration as YAML text, without `robot`
-  int line = 0;       ///< where it is defined in the scenario
+  std::string yaml;  ///< the scheme's configuration as YAML text, without `robot`
+  int line = 0;      ///< where it is defined in the scenario
 };
 
 struct Scenario {
@@ -27,17 +27,18 @@ struct Scenario {
   std::filesystem::path robot_path;
   RobotDescription robot;
   std::vector<std::uint64_t> seeds{1};
-  double model_error = 0.01;           ///< ± fraction of every dynamic parameter (SPEC 5)
-  sim::SimulationConfig simulation;    ///< forces, sensors, duration, steps (noise seed per run)
+  double model_error = 0.01;         ///< ± fraction of every dynamic parameter (SPEC 5)
+  sim::SimulationConfig simulation;  ///< forces, sensors, duration, steps (noise seed per run)
   sim::SinusoidalTrajectory trajectory;
   sim::PidGains gains;
-  double controller_omega = 0.0;       ///< when the gains come from `controller.omega`
-  bool log_velocity = true;            ///< write dq1..dqn (else estimate differentiates q)
+  double controller_omega = 0.0;  ///< when the gains come from `controller.omega`
+  bool log_velocity = true;       ///< write dq1..dqn (else estimate differentiates q)
   // Metrics
-  double metrics_from = 0.2;           ///< [s] start of every window (after the residual's transient)
+  double metrics_from = 0.2;  ///< [s] start of every window (after the residual's transient)
   std::vector<std::pair<double, double>> metrics_exclude;
-  double singularity_half_width = 0.0; ///< > 0: a second window excluding ± this around the peak
-  std::string singularity_link;        ///< link l whose cond(J of O_l) is tracked (default: first force's)
+  double singularity_half_width = 0.0;  ///< > 0: a second window excluding ± this around the peak
+  std::string
+      singularity_link;  ///< link l whose cond(J of O_l) is tracked (default: first force's)
   bool surface_metrics = false;
   bool figures = true;
   std::vector<SchemeSpec> schemes;
@@ -45,7 +46,8 @@ struct Scenario {
 
 /// Reads a scenario and loads its robot. Throws extwrench::Error naming file, line and key
 /// (unknown keys, wrong types, sizes that do not match the robot, values out of range).
-[[nodiscard]] Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& robot_options = {});
+[[nodiscard]] Scenario load_scenario(const std::filesystem::path& path,
+                                     const LoadOptions& robot_options = {});
 
 struct SchemeResult {
   std::string name;
@@ -56,8 +58,8 @@ struct SeedResult {
   std::uint64_t seed = 0;
   std::filesystem::path dir;
   long samples = 0;
-  double peak_condition = 0.0;      ///< max of cond(J of O_l) over the run (true q)
-  double peak_time = 0.0;           ///< [s]
+  double peak_condition = 0.0;  ///< max of cond(J of O_l) over the run (true q)
+  double peak_time = 0.0;       ///< [s]
   std::vector<SchemeResult> schemes;
 };
 

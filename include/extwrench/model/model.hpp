@@ -19,9 +19,9 @@ enum class JointType { kRevolute, kPrismatic };
 
 /// Mass properties of a rigid body, in the body frame.
 struct Inertia {
-  double mass = 0.0;                        ///< [kg]
-  Vector3 com = Vector3::Zero();            ///< centre of mass in the body frame [m]
-  Matrix3 inertia_com = Matrix3::Zero();    ///< rotational inertia about the CoM, body axes [kg m^2]
+  double mass = 0.0;                      ///< [kg]
+  Vector3 com = Vector3::Zero();          ///< centre of mass in the body frame [m]
+  Matrix3 inertia_com = Matrix3::Zero();  ///< rotational inertia about the CoM, body axes [kg m^2]
 
   /// Sum of two bodies' mass properties expressed in the same frame.
   Inertia operator+(const Inertia& other) const;
@@ -34,28 +34,28 @@ struct Inertia {
 struct Joint {
   std::string name;
   JointType type = JointType::kRevolute;
-  Pose placement;                       ///< X_{parent body, joint frame} at q = 0
-  Vector3 axis = Vector3::UnitZ();      ///< unit axis in the joint (= child body) frame
-  double lower = -std::numeric_limits<double>::infinity();   ///< position limit [rad | m]
+  Pose placement;                   ///< X_{parent body, joint frame} at q = 0
+  Vector3 axis = Vector3::UnitZ();  ///< unit axis in the joint (= child body) frame
+  double lower = -std::numeric_limits<double>::infinity();  ///< position limit [rad | m]
   double upper = std::numeric_limits<double>::infinity();
   double velocity_limit = std::numeric_limits<double>::infinity();
   double effort_limit = std::numeric_limits<double>::infinity();
-  double damping = 0.0;                 ///< viscous friction [N m s/rad | N s/m] (URDF <dynamics>)
-  double friction = 0.0;                ///< Coulomb friction [N m | N] (URDF <dynamics>)
+  double damping = 0.0;   ///< viscous friction [N m s/rad | N s/m] (URDF <dynamics>)
+  double friction = 0.0;  ///< Coulomb friction [N m | N] (URDF <dynamics>)
 };
 
 /// A body: one or more URDF links welded together by fixed joints.
 struct Body {
-  std::string name;   ///< name of the first (moving) link of the body
-  Inertia inertia;    ///< merged mass properties in the body frame
+  std::string name;  ///< name of the first (moving) link of the body
+  Inertia inertia;   ///< merged mass properties in the body frame
 };
 
 /// A named frame rigidly attached to a body: every URDF link (merged ones too), DH frames,
 /// sensor or tool frames.
 struct Frame {
   std::string name;
-  int body = 0;       ///< index of the body it is attached to
-  Pose placement;     ///< X_{body, frame}
+  int body = 0;    ///< index of the body it is attached to
+  Pose placement;  ///< X_{body, frame}
 };
 
 /// Constant description of a fixed-base kinematic tree with 1-DoF joints.
@@ -65,10 +65,10 @@ struct Frame {
 /// order: parent(i) < i. A serial chain has parent(i) = i - 1.
 struct Model {
   std::string name;
-  std::vector<Body> bodies;     ///< size n + 1
-  std::vector<Joint> joints;    ///< size n + 1; joints[0] is unused (the root has no joint)
-  std::vector<int> parents;     ///< size n + 1; parents[0] = -1
-  std::vector<Frame> frames;    ///< every named frame, one per URDF link at least
+  std::vector<Body> bodies;          ///< size n + 1
+  std::vector<Joint> joints;         ///< size n + 1; joints[0] is unused (the root has no joint)
+  std::vector<int> parents;          ///< size n + 1; parents[0] = -1
+  std::vector<Frame> frames;         ///< every named frame, one per URDF link at least
   Vector3 gravity{0.0, 0.0, -9.81};  ///< gravity acceleration in the root (world) frame [m/s^2]
 
   /// Number of joint coordinates n (= number of moving bodies).

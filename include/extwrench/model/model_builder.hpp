@@ -12,8 +12,8 @@ namespace extwrench {
 
 struct LinkSpec {
   std::string name;
-  Inertia inertia;       ///< in the link frame (URDF <inertial> already applied)
-  std::string source;    ///< where it was defined, for error messages, e.g. "robot.urdf:12"
+  Inertia inertia;     ///< in the link frame (URDF <inertial> already applied)
+  std::string source;  ///< where it was defined, for error messages, e.g. "robot.urdf:12"
   /// Where the mass properties were given (e.g. the <inertia> element); empty: `source`.
   std::string inertia_source;
 };
@@ -23,9 +23,9 @@ enum class JointSpecType { kRevolute, kContinuous, kPrismatic, kFixed };
 struct JointSpec {
   std::string name;
   JointSpecType type = JointSpecType::kRevolute;
-  std::string parent;    ///< parent link name
-  std::string child;     ///< child link name
-  Pose origin;           ///< X_{parent link, child link} at q = 0
+  std::string parent;               ///< parent link name
+  std::string child;                ///< child link name
+  Pose origin;                      ///< X_{parent link, child link} at q = 0
   Vector3 axis = Vector3::UnitX();  ///< URDF default axis (1, 0, 0); need not be unit, not zero
   double lower = -std::numeric_limits<double>::infinity();
   double upper = std::numeric_limits<double>::infinity();
@@ -40,7 +40,7 @@ struct JointSpec {
 struct FrameSpec {
   std::string name;
   std::string link;
-  Pose placement;        ///< X_{link, frame}
+  Pose placement;  ///< X_{link, frame}
   std::string source;
 };
 

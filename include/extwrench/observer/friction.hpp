@@ -13,8 +13,8 @@
 namespace extwrench {
 
 struct JointFriction {
-  VectorX viscous;   ///< D_i ≥ 0 (n) [N m s/rad | N s/m]
-  VectorX coulomb;   ///< F_c,i ≥ 0 (n) [N m | N]
+  VectorX viscous;                   ///< D_i ≥ 0 (n) [N m s/rad | N s/m]
+  VectorX coulomb;                   ///< F_c,i ≥ 0 (n) [N m | N]
   double smoothing_velocity = 1e-3;  ///< v_s > 0 [rad/s | m/s]
 
   /// No friction on n joints.

@@ -95,7 +95,8 @@ class MomentumObserver {
   enum class Extras { kWorldInertias, kNone, kWorldInertiasAndBias };
   /// update() without the input checks: the caller has validated (t, q, q̇, τ).
   void advance(double t, const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
-               const Eigen::Ref<const VectorX>& tau, Extras extras = Extras::kWorldInertias) noexcept;
+               const Eigen::Ref<const VectorX>& tau,
+               Extras extras = Extras::kWorldInertias) noexcept;
   void compute_terms(const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
                      Extras extras = Extras::kWorldInertias) noexcept;
   void apply_payload(int body, const Inertia* payload) noexcept;
@@ -110,12 +111,12 @@ class MomentumObserver {
 
   // State.
   bool initialized_ = false;
-  bool have_tau_ = false;   ///< tau_prev_ holds the torque of the current interval
+  bool have_tau_ = false;  ///< tau_prev_ holds the torque of the current interval
   double t_ = 0.0;
-  VectorX r_;               ///< residual r_k
-  VectorX m_prev_;          ///< m_k = B(q_k) q̇_k
-  VectorX gamma_prev_;      ///< γ_k = Cᵀq̇ − g − τ_f at sample k
-  VectorX tau_prev_;        ///< τ_k (held over [t_k, t_{k+1}))
+  VectorX r_;           ///< residual r_k
+  VectorX m_prev_;      ///< m_k = B(q_k) q̇_k
+  VectorX gamma_prev_;  ///< γ_k = Cᵀq̇ − g − τ_f at sample k
+  VectorX tau_prev_;    ///< τ_k (held over [t_k, t_{k+1}))
   VectorX q_prev_, dq_prev_;
 
   // Cached e^{−K Δt} for the last Δt (uniform sampling computes the exponentials once).

@@ -28,11 +28,11 @@ struct ForceProfile {
   Vector3 point = Vector3::Zero();   ///< application point in `frame` [m]
   double start = 0.0;                ///< [s]
   double end = std::numeric_limits<double>::infinity();  ///< [s]
-  double ramp = 0.0;                 ///< [s]
+  double ramp = 0.0;                                     ///< [s]
 
   // Resolved against a Model:
-  int body = -1;                     ///< body the frame is attached to
-  Pose X_BF;                         ///< placement of the frame on the body
+  int body = -1;  ///< body the frame is attached to
+  Pose X_BF;      ///< placement of the frame on the body
 
   /// Looks the frame up in `model`; throws extwrench::Error naming it when missing.
   void resolve(const Model& model);

@@ -54,8 +54,8 @@ struct ErrorStat {
 
 struct Metrics {
   MetricsWindow window;
-  long samples = 0;            ///< samples in the window
-  long contact_samples = 0;    ///< in contact (single contact) in the window
+  long samples = 0;          ///< samples in the window
+  long contact_samples = 0;  ///< in contact (single contact) in the window
   long free_samples = 0;
   /// ‖F̂ − F‖ over every sample of the window where the estimator gave a force (F̂ = 0 when it
   /// reports no contact, F = 0 when free).
@@ -66,19 +66,19 @@ struct Metrics {
   ErrorStat line;
   /// ‖p_c − p‖, in-contact samples with a surface point (meaningful when p lies on the surface).
   ErrorStat surface;
-  long force_not_estimated = 0;   ///< contact reported but no force estimated
-  long line_not_estimated = 0;    ///< in contact, no line of action
-  long right_link = 0;            ///< in contact, detected on the right link
-  long missed = 0;                ///< in contact, not detected
-  long false_alarms = 0;          ///< free, contact reported
+  long force_not_estimated = 0;  ///< contact reported but no force estimated
+  long line_not_estimated = 0;   ///< in contact, no line of action
+  long right_link = 0;           ///< in contact, detected on the right link
+  long missed = 0;               ///< in contact, not detected
+  long false_alarms = 0;         ///< free, contact reported
   // Detection delay: over the whole log (not windowed), from each onset of contact.
   long onsets = 0;
   long onsets_detected = 0;
   double delay_sum = 0.0;
   double delay_max = 0.0;
 
-  [[nodiscard]] double isolation_accuracy() const noexcept;   ///< right_link / contact_samples
-  [[nodiscard]] double false_alarm_rate() const noexcept;     ///< false_alarms / free_samples
+  [[nodiscard]] double isolation_accuracy() const noexcept;  ///< right_link / contact_samples
+  [[nodiscard]] double false_alarm_rate() const noexcept;    ///< false_alarms / free_samples
   [[nodiscard]] double mean_detection_delay() const noexcept;
 };
 
@@ -97,6 +97,7 @@ class MetricsAccumulator {
 };
 
 /// Distance from point p to the line through a with unit direction u.
-[[nodiscard]] double point_line_distance(const Vector3& p, const Vector3& a, const Vector3& u) noexcept;
+[[nodiscard]] double point_line_distance(const Vector3& p, const Vector3& a,
+                                         const Vector3& u) noexcept;
 
 }  // namespace extwrench::sim

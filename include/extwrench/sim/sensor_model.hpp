@@ -14,8 +14,8 @@ enum class BaseSensorType { kNone, kForce, kForceTorque };
 /// its origin, plus a constant bias and white Gaussian noise per axis.
 struct BaseSensorModel {
   BaseSensorType type = BaseSensorType::kForceTorque;
-  Pose X_RS;                         ///< pose of the sensor frame in the robot's root frame
-  Vector6 bias = Vector6::Zero();    ///< [N; N m] added to every reading
+  Pose X_RS;                               ///< pose of the sensor frame in the robot's root frame
+  Vector6 bias = Vector6::Zero();          ///< [N; N m] added to every reading
   Vector3 force_noise = Vector3::Zero();   ///< standard deviation per axis [N]
   Vector3 moment_noise = Vector3::Zero();  ///< standard deviation per axis [N m]
 

@@ -12,13 +12,13 @@
 namespace extwrench::sim {
 
 struct SimulationConfig {
-  double duration = 6.0;       ///< [s]; samples at t = k · sample_time for k · sample_time <= duration
-  double sample_time = 1e-3;   ///< controller and logging period [s]
-  int substeps = 1;            ///< RK4 steps per sample (integration step = sample_time / substeps)
+  double duration = 6.0;  ///< [s]; samples at t = k · sample_time for k · sample_time <= duration
+  double sample_time = 1e-3;  ///< controller and logging period [s]
+  int substeps = 1;           ///< RK4 steps per sample (integration step = sample_time / substeps)
   std::vector<ForceProfile> forces;
   BaseSensorModel sensor;
   EncoderModel encoder;
-  std::uint64_t noise_seed = 1;   ///< seed of the sensor noise stream
+  std::uint64_t noise_seed = 1;  ///< seed of the sensor noise stream
   /// Initial state; empty: the desired trajectory's q_d(0), q̇_d(0).
   VectorX q0, dq0;
 };
@@ -35,8 +35,7 @@ struct Rk4Workspace {
 /// True acceleration q̈ = B⁻¹ (τ + τ_ext − c) at (t, q, q̇) with the forces active at t.
 /// Writes workspace.data.ddq and workspace.tau_ext. Returns false if B is not positive definite.
 bool true_acceleration(const Model& model, std::span<const ForceProfile> forces, double t,
-                       const VectorX& q, const VectorX& dq, const VectorX& tau,
-                       Rk4Workspace& ws);
+                       const VectorX& q, const VectorX& dq, const VectorX& tau, Rk4Workspace& ws);
 
 /// One classical Runge–Kutta step of length h from t with τ held constant; forces are
 /// re-evaluated at the stage times and configurations. Returns false on a singular B.

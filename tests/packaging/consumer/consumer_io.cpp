@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   const extwrench::Vector6 reading = extwrench::sensor_reading(data, extwrench::Pose::identity());
   const double weight = robot.model.total_mass() * 9.81;
   std::printf("%s: %d joints, fs_z = %s N, weight %s N\n", argv[1], n,
-              extwrench::CsvWriter::format(reading[2]).c_str(), extwrench::CsvWriter::format(weight).c_str());
+              extwrench::CsvWriter::format(reading[2]).c_str(),
+              extwrench::CsvWriter::format(weight).c_str());
   return std::abs(reading[2] + weight) <= 1e-9 * weight ? 0 : 1;
 }
