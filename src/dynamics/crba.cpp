@@ -137,6 +137,7 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
   Vector3 w = Vector3::Zero();
   Vector3 a_O = -g;
   Vector3 w_dot = Vector3::Zero();
+  detail::joint_sin_cos(model, data, q);
   for (int i = 1; i < nb; ++i) {
     const int p = model.parents[i];
     if (p != i - 1) {

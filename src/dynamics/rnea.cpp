@@ -78,6 +78,7 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
   Vector3 a_O = -model.gravity;
   Vector3 w_dot = Vector3::Zero();
   Pose X_parent;  // likewise the parent's pose
+  detail::joint_sin_cos(model, data, q);
   for (int i = 1; i < nb; ++i) {
     const int p = model.parents[i];
     if (p != i - 1) {

@@ -72,11 +72,8 @@ inline void sin_cos(double angle, double& s, double& c) {
 #endif
 }
 
-/// Rotation by `angle` about the unit `axis` (Rodrigues).
-inline Matrix3 axis_rotation(const Vector3& axis, double angle) {
-  double s = 0.0;
-  double c = 0.0;
-  sin_cos(angle, s, c);
+/// Rotation by the angle of sine s and cosine c about the unit `axis` (Rodrigues).
+inline Matrix3 axis_rotation(const Vector3& axis, double s, double c) {
   const double t = 1.0 - c;
   const double x = axis.x(), y = axis.y(), z = axis.z();
   Matrix3 r;
@@ -86,53 +83,36 @@ inline Matrix3 axis_rotation(const Vector3& axis, double angle) {
   return r;
 }
 
+/// sin and cos of every joint coordinate into data.sin_q, data.cos_q, before a pose pass: the
+/// libm calls then run back to back, not inside the chain, where each call would push the pose
+/// and motion carried in registers out to the stack (every vector register is caller-saved)
+/// and reload them piecewise, which stalls store forwarding.
+inline void joint_sin_cos(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  const int n = model.nq();
+  for (int j = 0; j < n; ++j) sin_cos(q[j], data.sin_q[j], data.cos_q[j]);
+}
+
 /// Pose (R, p) of body i and its joint's motion subspace S_i = [s_lin; s_ang] (world, about the
-/// world origin), from the parent's pose X_WP and q_i, into local variables: callers keep them
-/// in registers and store them once (reloading vectors just written piecewise stalls the CPU's
-/// store forwarding). Uses Data's classification of the joint (right-angle placement,
-/// coordinate axis: the DH/URDF norm) to replace 3x3 products by column shuffles.
+/// world origin), from the parent's pose X_WP, q_i and its sine and cosine in data (joint_sin_cos
+/// first), into local variables: callers keep them in registers and store them once (reloading
+/// vectors just written piecewise stalls the CPU's store forwarding). The joint's rotation is
+/// Data's precomputed E_i(q) (no branch on the joint).
 [[gnu::always_inline]] inline void joint_kinematics(const Model& model, const Data& data, int i,
                                                     const Pose& X_WP, double qi, Matrix3& R,
                                                     Vector3& p, Vector3& s_lin, Vector3& s_ang) {
   const Joint& joint = model.joints[i];
-  const auto& perm = data.placement_axis[i];
-  Matrix3 R_WJ;  // joint frame at q = 0
-  if (perm[0] >= 0) {
-    const Vector3& sign = data.placement_sign[i];
-    for (int k = 0; k < 3; ++k) R_WJ.col(k) = sign[k] * X_WP.rotation.col(perm[k]);
-  } else {
-    R_WJ.noalias() = X_WP.rotation * joint.placement.rotation;
-  }
+  const bool revolute = joint.type == JointType::kRevolute;
+  const Matrix3 E = data.rotation_const[i] + data.cos_q[i - 1] * data.rotation_cos[i] +
+                    data.sin_q[i - 1] * data.rotation_sin[i];
+  R.noalias() = X_WP.rotation * E;
   p.noalias() = X_WP.rotation * joint.placement.translation;
   p += X_WP.translation;
-  const int k = data.axis_index[i];
-  const bool revolute = joint.type == JointType::kRevolute;
-  if (k >= 0) {
-    const double sign = data.axis_sign[i];
-    s_ang = sign * R_WJ.col(k);
-    if (revolute) {
-      // Rot(±e_k, q) only mixes the two other columns: i -> c e_i + s e_j, j -> -s e_i + c e_j.
-      double s = 0.0;
-      double c = 0.0;
-      sin_cos(qi, s, c);
-      s *= sign;
-      constexpr int kNext[3] = {1, 2, 0};
-      const int i1 = kNext[k];
-      const int j1 = kNext[i1];
-      R.col(k) = R_WJ.col(k);
-      R.col(i1) = c * R_WJ.col(i1) + s * R_WJ.col(j1);
-      R.col(j1) = c * R_WJ.col(j1) - s * R_WJ.col(i1);
-    }
-  } else {
-    s_ang.noalias() = R_WJ * joint.axis;
-    if (revolute) R.noalias() = R_WJ * axis_rotation(joint.axis, qi);
-  }
+  s_ang.noalias() = X_WP.rotation * data.axis_P[i];
   if (revolute) {
     // Revolute about the axis through O_i: the body point at the world origin moves with
     // O_i x axis q_dot.
     s_lin = p.cross(s_ang);
   } else {
-    R = R_WJ;
     p += s_ang * qi;
     s_lin = s_ang;  // prismatic: S = [axis; 0]
     s_ang.setZero();
@@ -185,6 +165,7 @@ inline void poses_and_subspaces(const Model& model, Data& data,
   const int nb = model.num_bodies();
   data.X_WB[0] = Pose{};
   data.S[0].setZero();
+  joint_sin_cos(model, data, q);
   for (int i = 1; i < nb; ++i) {
     joint_kinematics(model, data, i, q[i - 1]);
   }

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <Eigen/Cholesky>
-#include <array>
 #include <vector>
 
 #include "extwrench/model/model.hpp"
@@ -17,15 +16,13 @@ struct Data {
   explicit Data(const Model& model);
 
   // --- derived from the model once, for the hot path ---
-  /// Joint i's placement rotation when it is a signed permutation (right angles: the DH and
-  /// URDF norm): column k of R = placement_sign[i][k] · e_{placement_axis[i][k]}, so composing
-  /// it with the parent's rotation is a column shuffle, not a 3x3 product. Axis −1: general.
-  std::vector<std::array<int, 3>> placement_axis;
-  std::vector<Vector3> placement_sign;
-  /// Joint i's axis when it is a coordinate axis: axis = axis_sign[i] · e_{axis_index[i]};
-  /// index −1: general axis.
-  std::vector<int> axis_index;
-  std::vector<double> axis_sign;
+  /// Joint i's rotation from the parent body frame as E_i(q) = rotation_const + cos q ·
+  /// rotation_cos + sin q · rotation_sin (Rodrigues premultiplied by the placement rotation P_i:
+  /// P_i (a aᵀ + cos q (1 − a aᵀ) + sin q [a]×), a the unit axis; prismatic: P_i, 0, 0), so the
+  /// pose pass is the same two fixed-size 3x3 products for every joint, with no branch on its
+  /// type or axis and nothing indexed at run time.
+  std::vector<Matrix3> rotation_const, rotation_cos, rotation_sin;
+  std::vector<Vector3> axis_P;  ///< P_i a: joint i's axis in the parent body frame
 
   // --- forward kinematics (forward_kinematics) ---
   std::vector<Pose> X_WB;  ///< pose of each body frame in the world
@@ -64,6 +61,7 @@ struct Data {
   std::vector<Matrix6> Bc;       ///< composite v x* I of each subtree (for C)
   std::vector<Vector6> Sdot;     ///< time derivative of S
   VectorX tmp_n;                 ///< (n) scratch
+  VectorX sin_q, cos_q;          ///< (n) sin and cos of each joint coordinate (pose passes)
   Eigen::LLT<MatrixX> mass_llt;  ///< factorization of M, sized once
 };
 
