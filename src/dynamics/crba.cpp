@@ -197,21 +197,92 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
     X_parent.rotation = R;
     X_parent.translation = O;
   }
+  // Subtree sums, in 3-vectors: along a chain the child's are carried in registers (as in
+  // rnea's backward pass), at a branching added into the parent's entries. (6-vectors read
+  // back whole after piecewise writes would stall store forwarding.)
+  Vector3 L_child = Vector3::Zero();  // H = [L; K]: subtree momentum about the world origin
+  Vector3 K_child = Vector3::Zero();
+  double m_child = 0.0;
+  Vector3 h_child = Vector3::Zero();  // subtree first moment m c
+  Vector3 F_child = Vector3::Zero();  // subtree bias wrench (full)
+  Vector3 N_child = Vector3::Zero();
   for (int i = nb - 1; i > 0; --i) {
     const int p = model.parents[i];
-    const Vector6& s = data.S[i];
-    data.momentum[i - 1] = s.dot(data.f[i]);  // p_i = S_i^T H_i
-    // (C^T q_dot)_i = -S_i^T (v_p x* H_i) (see momentum_terms_no_kinematics)
-    data.coriolis_transpose_dq[i - 1] = -s.dot(detail::cross_force(data.v[p], data.f[i]));
-    const double mc = data.composite_mass[i];
-    const Vector3& hc = data.composite_first_moment[i];
-    data.gravity_torque[i - 1] = -(s.head<3>().dot(mc * g) + s.tail<3>().dot(hc.cross(g)));
-    data.f[p] += data.f[i];
-    data.composite_mass[p] += mc;
-    data.composite_first_moment[p] += hc;
+    const bool chain_child = i + 1 < nb && model.parents[i + 1] == i;
+    Vector3 L = data.f[i].head<3>();
+    Vector3 K = data.f[i].tail<3>();
+    double m = data.composite_mass[i];
+    Vector3 h = data.composite_first_moment[i];
+    Vector3 F;
+    Vector3 N;
     if constexpr (full) {
-      data.tau[i - 1] = s.dot(data.bias_f[i]);  // c_i = S_i^T f_i  (f_i: the subtree's)
-      data.bias_f[p] += data.bias_f[i];
+      F = data.bias_f[i].head<3>();
+      N = data.bias_f[i].tail<3>();
+    }
+    if (chain_child) {
+      L += L_child;
+      K += K_child;
+      m += m_child;
+      h += h_child;
+      if constexpr (full) {
+        F += F_child;
+        N += N_child;
+      }
+    }
+    data.f[i].head<3>() = L;
+    data.f[i].tail<3>() = K;
+    data.composite_mass[i] = m;
+    data.composite_first_moment[i] = h;
+    const Vector3 s_lin = data.S[i].head<3>();
+    const Vector3 s_ang = data.S[i].tail<3>();
+    const Vector3 v_O = data.v[p].head<3>();
+    const Vector3 w = data.v[p].tail<3>();
+    data.momentum[i - 1] = s_lin.dot(L) + s_ang.dot(K);  // p_i = S_i^T H_i
+    // (C^T q_dot)_i = -S_i^T (v_p x* H_i) (see momentum_terms_no_kinematics), with
+    // v x* [L; K] = [w x L; v_O x L + w x K].
+    data.coriolis_transpose_dq[i - 1] =
+        -(s_lin.dot(w.cross(L)) + s_ang.dot(v_O.cross(L) + w.cross(K)));
+    // g_i = -S_i^T [m g; h x g] (the subtree's weight)
+    data.gravity_torque[i - 1] = -(s_lin.dot(m * g) + s_ang.dot(h.cross(g)));
+    if constexpr (full) {
+      data.bias_f[i].head<3>() = F;
+      data.bias_f[i].tail<3>() = N;
+      data.tau[i - 1] = s_lin.dot(F) + s_ang.dot(N);  // c_i = S_i^T f_i  (f_i: the subtree's)
+    }
+    if (p == i - 1) {
+      L_child = L;
+      K_child = K;
+      m_child = m;
+      h_child = h;
+      if constexpr (full) {
+        F_child = F;
+        N_child = N;
+      }
+    } else {
+      data.f[p].head<3>() += L;
+      data.f[p].tail<3>() += K;
+      data.composite_mass[p] += m;
+      data.composite_first_moment[p] += h;
+      if constexpr (full) {
+        data.bias_f[p].head<3>() += F;
+        data.bias_f[p].tail<3>() += N;
+      }
+      L_child.setZero();
+      K_child.setZero();
+      m_child = 0.0;
+      h_child.setZero();
+      F_child.setZero();
+      N_child.setZero();
+    }
+  }
+  if (nb > 1 && model.parents[1] == 0) {
+    data.f[0].head<3>() += L_child;
+    data.f[0].tail<3>() += K_child;
+    data.composite_mass[0] += m_child;
+    data.composite_first_moment[0] += h_child;
+    if constexpr (full) {
+      data.bias_f[0].head<3>() += F_child;
+      data.bias_f[0].tail<3>() += N_child;
     }
   }
   if constexpr (full) data.root_wrench_W = data.bias_f[0];
