@@ -114,7 +114,7 @@ void MomentumObserver::compute_terms(const Eigen::Ref<const VectorX>& q,
     case Extras::kNone:
       momentum_terms(model_, data_, q, dq);
       break;
-    case Extras::kWorldInertias:  // the workspace() contract for update() and reset()
+    case Extras::kWorldInertias:
       momentum_terms(model_, data_, q, dq);
       world_mass_properties(model_, data_);
       break;

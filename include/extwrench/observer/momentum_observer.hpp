@@ -81,10 +81,12 @@ class MomentumObserver {
   [[nodiscard]] const VectorX& friction_torque() const noexcept { return tau_f_; }
   [[nodiscard]] int nq() const noexcept { return n_; }
 
-  /// The dynamics workspace. After update()/reset() its forward kinematics (X_WB, S, world
-  /// mass properties) are those of the last q, and momentum / coriolis_transpose_dq /
-  /// gravity_torque those of the last (q, q̇); every other buffer is scratch that a caller
-  /// (the ContactEstimator) may overwrite with *_no_kinematics algorithms between updates.
+  /// The dynamics workspace. After update()/reset() its poses and motion subspaces (X_WB, S)
+  /// are those of the last q, and momentum / coriolis_transpose_dq / gravity_torque those of
+  /// the last (q, q̇). The world-frame mass properties are not computed (the residual does not
+  /// need them): call world_mass_properties(model(), workspace()) before a *_no_kinematics
+  /// algorithm that reads them. Every other buffer is scratch that a caller (the
+  /// ContactEstimator) may overwrite between updates.
   [[nodiscard]] Data& workspace() noexcept { return data_; }
   [[nodiscard]] const Data& workspace() const noexcept { return data_; }
 
@@ -92,13 +94,13 @@ class MomentumObserver {
   friend class ContactEstimator;  // validates the sample itself, then calls advance()
 
   /// What advance() leaves in the workspace besides the momentum terms and the poses.
-  enum class Extras { kWorldInertias, kNone, kWorldInertiasAndBias };
+  enum class Extras { kNone, kWorldInertias, kWorldInertiasAndBias };
   /// update() without the input checks: the caller has validated (t, q, q̇, τ).
   void advance(double t, const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
                const Eigen::Ref<const VectorX>& tau,
-               Extras extras = Extras::kWorldInertias) noexcept;
+               Extras extras = Extras::kNone) noexcept;
   void compute_terms(const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
-                     Extras extras = Extras::kWorldInertias) noexcept;
+                     Extras extras = Extras::kNone) noexcept;
   void apply_payload(int body, const Inertia* payload) noexcept;
 
   Model model_;
