@@ -154,23 +154,15 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
     Vector3 s_lin;
     Vector3 s_ang;
     detail::joint_kinematics(model, data, i, X_parent, q[i - 1], R, O, s_lin, s_ang);
-    const Vector3 vj_lin = s_lin * dq[i - 1];
-    const Vector3 vj_ang = s_ang * dq[i - 1];
-    if constexpr (full) {
-      // a_i = a_p + v_p x S q_dot  (q_ddot = 0)
-      a_O += w.cross(vj_lin) + v_O.cross(vj_ang);
-      w_dot += w.cross(vj_ang);
-    }
-    v_O += vj_lin;
-    w += vj_ang;
+    detail::propagate_motion<full>(s_lin, s_ang, dq[i - 1], 0.0, v_O, w, a_O, w_dot);
     const Inertia& inertia = model.bodies[i].inertia;
     const Vector3 c = R * inertia.com + O;
     // h_i about the world origin: [m v_c; I_c,W w + c x m v_c], v_c the velocity of the CoM.
     const Vector3 v_c = v_O + w.cross(c);
     const Vector3 L = inertia.mass * v_c;
     const Vector3 w_B = R.transpose() * w;
-    const Vector3 Iw = R * (inertia.inertia_com * w_B);  // I_c,W w
-    const Vector3 K = Iw + c.cross(L);
+    const Vector3 Iw_B = inertia.inertia_com * w_B;
+    const Vector3 K = R * Iw_B + c.cross(L);  // I_c,W w + c x L
     data.X_WB[i].rotation = R;
     data.X_WB[i].translation = O;
     data.S[i].head<3>() = s_lin;
@@ -186,10 +178,9 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
     if constexpr (full) {
       data.a[i].head<3>() = a_O;
       data.a[i].tail<3>() = w_dot;
-      // Newton-Euler about the CoM (see rnea): F = m c_ddot, N_c = I_c,W w_dot + w x I_c,W w.
-      const Vector3 F = inertia.mass * (a_O + w_dot.cross(c) + w.cross(v_c));
-      const Vector3 N =
-          R * (inertia.inertia_com * (R.transpose() * w_dot)) + w.cross(Iw) + c.cross(F);
+      Vector3 F;  // the bias wrench at q_ddot = 0
+      Vector3 N;
+      detail::newton_euler_about_com(inertia, R, c, v_c, w, a_O, w_dot, w_B, Iw_B, F, N);
       data.bias_f[i].head<3>() = F;
       data.bias_f[i].tail<3>() = N;
       detail::world_mass_properties_of(model, data, i);

@@ -93,28 +93,15 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
     Vector3 s_lin;
     Vector3 s_ang;
     detail::joint_kinematics(model, data, i, X_parent, q[i - 1], R, O, s_lin, s_ang);
-    // v_i = v_p + S q_dot; a_i = a_p + S q_ddot + v_p x S q_dot (S_dot = v_p x S: S is fixed in
-    // the parent), with v x m = [w x m_v + v_O x m_w; w x m_w].
-    const double qd = dq[i - 1];
-    const double qdd = ddq[i - 1];
-    const Vector3 vj_lin = s_lin * qd;
-    const Vector3 vj_ang = s_ang * qd;
-    a_O += s_lin * qdd + w.cross(vj_lin) + v_O.cross(vj_ang);
-    w_dot += s_ang * qdd + w.cross(vj_ang);
-    v_O += vj_lin;
-    w += vj_ang;
-    // (7)-(8) about the CoM c: F = m c_ddot, N_c = I_c w_dot + w x I_c w (body axes, rotated
-    // back), then moved to the world origin: f_i = [F; N_c + c x F] (= I_i a_i + v_i x* I_i v_i).
+    detail::propagate_motion<true>(s_lin, s_ang, dq[i - 1], ddq[i - 1], v_O, w, a_O, w_dot);
     const Inertia& inertia = model.bodies[i].inertia;
     const Vector3 c = R * inertia.com + O;
-    // c_ddot = a_O + w_dot x c + w x (v_O + w x c): the spatial acceleration at the world origin
-    // turned into the classical acceleration of the body point at c.
     const Vector3 v_c = v_O + w.cross(c);
-    const Vector3 F = inertia.mass * (a_O + w_dot.cross(c) + w.cross(v_c));
     const Vector3 w_B = R.transpose() * w;
-    const Vector3 w_dot_B = R.transpose() * w_dot;
-    const Vector3 N_B = inertia.inertia_com * w_dot_B + w_B.cross(inertia.inertia_com * w_B);
-    const Vector3 N = R * N_B + c.cross(F);
+    Vector3 F;
+    Vector3 N;
+    detail::newton_euler_about_com(inertia, R, c, v_c, w, a_O, w_dot, w_B,
+                                   inertia.inertia_com * w_B, F, N);
     data.X_WB[i].rotation = R;
     data.X_WB[i].translation = O;
     data.S[i].head<3>() = s_lin;

@@ -133,6 +133,40 @@ inline void joint_sin_cos(const Model& model, Data& data, const Eigen::Ref<const
   data.S[i].tail<3>() = s_ang;
 }
 
+/// Body i's motion from its parent's along joint i, in place on [v_O; w] (and, with
+/// `with_acceleration`, [a_O; w_dot]): v_i = v_p + S q_dot, a_i = a_p + S q_ddot + v_p x S q_dot
+/// (S_dot = v_p x S: S is fixed in the parent), with v x m = [w x m_v + v_O x m_w; w x m_w].
+template <bool with_acceleration>
+[[gnu::always_inline]] inline void propagate_motion(const Vector3& s_lin, const Vector3& s_ang,
+                                                    double qd, double qdd, Vector3& v_O, Vector3& w,
+                                                    Vector3& a_O, Vector3& w_dot) {
+  const Vector3 vj_lin = s_lin * qd;
+  const Vector3 vj_ang = s_ang * qd;
+  if constexpr (with_acceleration) {
+    a_O += s_lin * qdd + w.cross(vj_lin) + v_O.cross(vj_ang);
+    w_dot += s_ang * qdd + w.cross(vj_ang);
+  }
+  v_O += vj_lin;
+  w += vj_ang;
+}
+
+/// SPEC (7)-(8) for one body about its CoM c (world), with the constant body-axes inertia I_c so
+/// that no world inertia R I_c R^T is formed: F = m c_ddot, N_c = R (I_c w_dot_B + w_B x I_c w_B),
+/// moved to the world origin: [F; N] = [F; N_c + c x F] (= I_i a_i + v_i x* I_i v_i). c_ddot =
+/// a_O + w_dot x c + w x v_c turns the spatial acceleration at the world origin into the classical
+/// acceleration of the body point at c; v_c is its velocity, w_B = R^T w, Iw_B = I_c w_B (the
+/// caller has them: the momentum needs them too).
+[[gnu::always_inline]] inline void newton_euler_about_com(const Inertia& inertia, const Matrix3& R,
+                                                          const Vector3& c, const Vector3& v_c,
+                                                          const Vector3& w, const Vector3& a_O,
+                                                          const Vector3& w_dot, const Vector3& w_B,
+                                                          const Vector3& Iw_B, Vector3& F,
+                                                          Vector3& N) {
+  F = inertia.mass * (a_O + w_dot.cross(c) + w.cross(v_c));
+  const Vector3 w_dot_B = R.transpose() * w_dot;
+  N = R * (inertia.inertia_com * w_dot_B + w_B.cross(Iw_B)) + c.cross(F);
+}
+
 /// Body i's mass properties about the world origin from its pose in data: m, h = m c_W and
 /// I_O = R I_c R^T + m (|c|^2 1 - c c^T).
 inline void world_mass_properties_of(const Model& model, Data& data, int i) {
