@@ -33,12 +33,13 @@ struct DlsInfo {
 /// A = L D Lᵀ in place (unit lower L below the diagonal, 1/D on it; the upper triangle is not
 /// read): no square roots, and the solves multiply by the stored inverse pivots, which keeps
 /// divisions off their dependency chains. False when A is not numerically positive definite.
-/// For the fixed-size J Jᵀ and for B(q) up to kMaxPivots joints: no allocation.
-constexpr int kMaxPivots = 12;
+/// Matrices of fixed capacity only (the fixed-size J Jᵀ, B(q) in mass_ldlt_): the pivots then
+/// fit on the stack, and nothing is allocated.
 template <typename Matrix>
 bool ldlt_in_place(Matrix& A) noexcept {
+  static_assert(Matrix::MaxRowsAtCompileTime != Eigen::Dynamic, "needs a fixed capacity");
   const int n = static_cast<int>(A.rows());
-  double d[kMaxPivots];
+  double d[Matrix::MaxRowsAtCompileTime];
   for (int j = 0; j < n; ++j) {
     double dj = A(j, j);
     for (int k = 0; k < j; ++k) dj -= A(j, k) * A(j, k) * d[k];
