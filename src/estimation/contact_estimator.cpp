@@ -79,7 +79,7 @@ constexpr int kSpectrumIterations = 4;
 /// columns (the joints up to the contact link) can be non-zero. x = (J Jᵀ + μ² I)⁻¹ J b with
 /// the damping law of the header, by an LDLᵀ factorisation (fixed size: no allocation). σ_min and
 /// σ_max come from the extreme eigenvalues of A = J Jᵀ: J moves little between samples, so a few
-/// power (λ_max) and inverse (λ_min, with the Cholesky factor) iterations from the previous
+/// power (λ_max) and inverse (λ_min, with the LDLᵀ factor) iterations from the previous
 /// sample's eigenvectors (`guess`, `guess_size` = R when valid) usually suffice; otherwise (first
 /// sample, a change of link, fast motion near a singularity) a full symmetric eigensolver gives
 /// them exactly and seeds the next sample. The normal equations square κ: with κ ≤ 1e3 the
