@@ -6,7 +6,6 @@
 #include <kdl/tree.hpp>
 #include <kdl_parser/kdl_parser.hpp>
 #include <memory>
-#include <numbers>
 #include <random>
 #include <stdexcept>
 
@@ -14,31 +13,13 @@
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "support/paper_arm_table.hpp"
 
 namespace extwrench::bench {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-// SPEC §5: standard DH, a_i = 0, θ_i = q_i.
-constexpr double kAlpha[7] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0};
-constexpr double kD[7] = {0, 0, 0.40, 0, 0.39, 0, 0.078};
-constexpr double kMass[7] = {2.7, 2.7, 2.7, 2.7, 2.7, 1.7, 0.3};
-constexpr double kComCm[7][3] = {{0.1340, -8.7777, 2.6220},
-                                 {0.1340, 2.6220, 8.7777},
-                                 {0.1340, 8.7777, 2.6220},
-                                 {0.1340, 2.6220, 8.7777},
-                                 {0.1340, -8.7777, 2.6220},
-                                 {0, 0.5, 0},
-                                 {0, 0, -2.0}};
-// Ixx Ixy Ixz Iyy Iyz Izz [g m^2], about the CoM, DH frame i axes.
-constexpr double kInertia[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
-                                   {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                                   {16.341, 0.003, 0.001, 5.026, 3.533, 16.173},
-                                   {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                                   {16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
-                                   {5.0, 0, 0, 3.6, 0, 4.7},
-                                   {1.0, 0, 0, 1.0, 0, 1.0}};
-constexpr double kLink0Height = 0.31;  // O_0 = O_s + (0, 0, 0.31)
+// SPEC §5's table, shared with the tests.
+using namespace test::paper_arm_table;
 
 Pose dh_pose(double d, double alpha) {  // Tz(d) Rx(alpha); the Rz(q) is the joint's motion
   Pose x;
@@ -56,9 +37,10 @@ Model paper_arm_model_from_dh() {
   m.parents.resize(8);
   m.parents[0] = -1;
   m.bodies[0].name = "link0";
-  m.bodies[0].inertia.mass = 2.0;
-  m.bodies[0].inertia.com = Vector3(0, 0, 0.15);
-  m.bodies[0].inertia.inertia_com = Vector3(0.020, 0.020, 0.010).asDiagonal();
+  m.bodies[0].inertia.mass = kLink0Mass;
+  m.bodies[0].inertia.com = Vector3(0, 0, kLink0ComZ);
+  m.bodies[0].inertia.inertia_com =
+      Vector3(kLink0Inertia[0], kLink0Inertia[1], kLink0Inertia[2]).asDiagonal();
   m.frames.push_back({"link0", 0, Pose{}});
   for (int i = 1; i <= 7; ++i) {
     const int k = i - 1;
@@ -70,7 +52,7 @@ Model paper_arm_model_from_dh() {
     Inertia in_dh;
     in_dh.mass = kMass[k];
     in_dh.com = Vector3(kComCm[k][0], kComCm[k][1], kComCm[k][2]) * 1e-2;
-    const double* c = kInertia[k];
+    const double* c = kInertiaGm2[k];
     in_dh.inertia_com << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
     in_dh.inertia_com *= 1e-3;
     m.bodies[i].name = "link" + std::to_string(i);
@@ -85,7 +67,7 @@ KDL::Chain paper_arm_chain_from_dh() {
   chain.addSegment(KDL::Segment("link0", KDL::Joint(KDL::Joint::None),
                                 KDL::Frame(KDL::Vector(0, 0, kLink0Height))));
   for (int k = 0; k < 7; ++k) {
-    const double* c = kInertia[k];
+    const double* c = kInertiaGm2[k];
     // KDL: inertia in the segment's tip frame (DH frame i), rotational part about the CoM.
     const KDL::RotationalInertia I(c[0] * 1e-3, c[3] * 1e-3, c[5] * 1e-3, c[1] * 1e-3, c[2] * 1e-3,
                                    c[4] * 1e-3);

@@ -13,6 +13,7 @@
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/geometry/shapes.hpp"
+#include "support/paper_arm_table.hpp"
 #include "support/random.hpp"
 #include "support/random_model.hpp"
 
@@ -30,25 +31,7 @@ inline Pose dh_transform(double d, double alpha) {
 /// Body i's frame sits at DH origin O_{i−1} with z along joint i's axis (it is DH frame i−1
 /// turned by q_i); frame "dh<i>" is DH frame i, attached to body i.
 inline Model paper_arm_model() {
-  constexpr double kPi = std::numbers::pi;
-  const double alpha[7] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0};
-  const double d[7] = {0, 0, 0.40, 0, 0.39, 0, 0.078};
-  const double mass[7] = {2.7, 2.7, 2.7, 2.7, 2.7, 1.7, 0.3};
-  const double com_cm[7][3] = {{0.1340, -8.7777, 2.6220},
-                               {0.1340, 2.6220, 8.7777},
-                               {0.1340, 8.7777, 2.6220},
-                               {0.1340, 2.6220, 8.7777},
-                               {0.1340, -8.7777, 2.6220},
-                               {0, 0.5, 0},
-                               {0, 0, -2.0}};
-  // Ixx Ixy Ixz Iyy Iyz Izz [g m^2]
-  const double in[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
-                           {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                           {16.341, 0.003, 0.001, 5.026, 3.533, 16.173},
-                           {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                           {16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
-                           {5.0, 0, 0, 3.6, 0, 4.7},
-                           {1.0, 0, 0, 1.0, 0, 1.0}};
+  using namespace paper_arm_table;
   Model m;
   m.name = "paper_arm";
   m.bodies.resize(8);
@@ -56,9 +39,10 @@ inline Model paper_arm_model() {
   m.parents.resize(8);
   m.parents[0] = -1;
   m.bodies[0].name = "link0";
-  m.bodies[0].inertia.mass = 2.0;
-  m.bodies[0].inertia.com = Vector3(0, 0, 0.15);
-  m.bodies[0].inertia.inertia_com = Vector3(0.020, 0.020, 0.010).asDiagonal();
+  m.bodies[0].inertia.mass = kLink0Mass;
+  m.bodies[0].inertia.com = Vector3(0, 0, kLink0ComZ);
+  m.bodies[0].inertia.inertia_com =
+      Vector3(kLink0Inertia[0], kLink0Inertia[1], kLink0Inertia[2]).asDiagonal();
   m.frames.push_back({"link0", 0, Pose{}});
   for (int i = 1; i <= 7; ++i) {
     const int k = i - 1;
@@ -67,17 +51,18 @@ inline Model paper_arm_model() {
     j.name = "joint" + std::to_string(i);
     j.axis = Vector3::UnitZ();
     if (i == 1) {
-      j.placement.translation = Vector3(0, 0, 0.31);
+      j.placement.translation = Vector3(0, 0, kLink0Height);
     } else {
-      j.placement = dh_transform(d[k - 1], alpha[k - 1]);
+      j.placement = dh_transform(kD[k - 1], kAlpha[k - 1]);
     }
     Inertia dh;
-    dh.mass = mass[k];
-    dh.com = Vector3(com_cm[k][0], com_cm[k][1], com_cm[k][2]) * 1e-2;
+    dh.mass = kMass[k];
+    dh.com = Vector3(kComCm[k][0], kComCm[k][1], kComCm[k][2]) * 1e-2;
     Matrix3 I;
-    I << in[k][0], in[k][1], in[k][2], in[k][1], in[k][3], in[k][4], in[k][2], in[k][4], in[k][5];
+    const double* in = kInertiaGm2[k];
+    I << in[0], in[1], in[2], in[1], in[3], in[4], in[2], in[4], in[5];
     dh.inertia_com = I * 1e-3;
-    const Pose X_B_dh = dh_transform(d[k], alpha[k]);
+    const Pose X_B_dh = dh_transform(kD[k], kAlpha[k]);
     m.bodies[i].name = "link" + std::to_string(i);
     m.bodies[i].inertia = dh.transformed(X_B_dh);
     m.frames.push_back({m.bodies[i].name, i, Pose{}});

@@ -2,37 +2,18 @@
 // models/paper_arm.urdf. Both must be the same robot, and both must be the SPEC's table.
 #include <gtest/gtest.h>
 
-#include <numbers>
 
 #include "extwrench/io/robot_loader.hpp"
 #include "io_test_util.hpp"
+#include "support/paper_arm_table.hpp"
 #include "support/random.hpp"
 
 namespace extwrench {
 namespace {
 
 constexpr double kTol = 1e-12;
-constexpr double kPi = std::numbers::pi;
-
-// SPEC section 5, written here from the SPEC (not from the model files).
-const double kAlpha[7] = {kPi / 2, -kPi / 2, -kPi / 2, kPi / 2, kPi / 2, -kPi / 2, 0.0};
-const double kD[7] = {0, 0, 0.40, 0, 0.39, 0, 0.078};
-const double kMass[7] = {2.7, 2.7, 2.7, 2.7, 2.7, 1.7, 0.3};
-const double kComCm[7][3] = {{0.1340, -8.7777, 2.6220},
-                             {0.1340, 2.6220, 8.7777},
-                             {0.1340, 8.7777, 2.6220},
-                             {0.1340, 2.6220, 8.7777},
-                             {0.1340, -8.7777, 2.6220},
-                             {0, 0.5, 0},
-                             {0, 0, -2.0}};
-// I_xx I_xy I_xz I_yy I_yz I_zz in g m^2
-const double kInertiaGm2[7][6] = {{16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
-                                  {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                                  {16.341, 0.003, 0.001, 5.026, 3.533, 16.173},
-                                  {16.341, 0.001, 0.003, 16.173, 3.533, 5.026},
-                                  {16.341, 0.003, 0.001, 5.026, -3.533, 16.173},
-                                  {5.0, 0, 0, 3.6, 0, 4.7},
-                                  {1.0, 0, 0, 1.0, 0, 1.0}};
+// SPEC section 5, written from the SPEC (not from the model files).
+using namespace test::paper_arm_table;
 
 RobotDescription load(const char* file) {
   LoadOptions o;
@@ -71,7 +52,7 @@ TEST(PaperArm, LinkFramesAreTheDhFramesOfTheSpecAtRandomConfigurations) {
     }
     // The base sensor S: 0.31 m below O_0, parallel to frame 0, whatever q.
     Eigen::Isometry3d S = Eigen::Isometry3d::Identity();
-    S.translation() = Eigen::Vector3d(0, 0, -0.31);
+    S.translation() = Eigen::Vector3d(0, 0, -kLink0Height);
     EXPECT_TRUE(test::near(test::world_frame_pose(yaml.model, Xy, "sensor"), S, kTol));
     EXPECT_TRUE(test::near(test::world_frame_pose(urdf.model, Xu, "sensor"), S, kTol));
   }
@@ -81,10 +62,12 @@ TEST(PaperArm, MassPropertiesAreTheSpecTableInTheDhFrames) {
   for (const char* file : {"paper_arm.yaml", "paper_arm.urdf"}) {
     const Model m = load(file).model;
     // Link 0: CoM 0.15 m above O_s = 0.31 m below O_0.
-    EXPECT_NEAR(m.bodies[0].inertia.mass, 2.0, kTol) << file;
-    EXPECT_TRUE(m.bodies[0].inertia.com.isApprox(Vector3(0, 0, 0.15 - 0.31), kTol)) << file;
+    EXPECT_NEAR(m.bodies[0].inertia.mass, kLink0Mass, kTol) << file;
+    EXPECT_TRUE(m.bodies[0].inertia.com.isApprox(Vector3(0, 0, kLink0ComZ - kLink0Height), kTol))
+        << file;
     EXPECT_TRUE(m.bodies[0].inertia.inertia_com.isApprox(
-        Vector3(0.020, 0.020, 0.010).asDiagonal().toDenseMatrix(), kTol));
+        Vector3(kLink0Inertia[0], kLink0Inertia[1], kLink0Inertia[2]).asDiagonal().toDenseMatrix(),
+        kTol));
     for (int i = 1; i <= 7; ++i) {
       const Inertia& in = m.bodies[static_cast<std::size_t>(i)].inertia;
       const double* I = kInertiaGm2[i - 1];
