@@ -5,10 +5,10 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "extwrench/app/replay.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/csv.hpp"
 #include "extwrench/io/estimator_config.hpp"
-#include "extwrench/io/replay.hpp"
 
 namespace extwrench::cli {
 namespace {

@@ -9,8 +9,8 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "extwrench/app/scenario_run.hpp"
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/scenario.hpp"
 
 namespace extwrench::cli {
 namespace {

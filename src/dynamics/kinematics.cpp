@@ -1,5 +1,8 @@
 #include "extwrench/dynamics/kinematics.hpp"
 
+#include <Eigen/SVD>
+#include <limits>
+
 #include "spatial.hpp"
 
 namespace extwrench {
@@ -33,6 +36,17 @@ void point_jacobian(const Model& model, const Data& data, int body, const Vector
 const Matrix6X& body_jacobian(const Model& model, Data& data, int body) {
   point_jacobian(model, data, body, data.X_WB[body].translation, data.J);
   return data.J;
+}
+
+double jacobian_condition(const Model& model, const Data& data, int body) {
+  if (body <= 0) return std::numeric_limits<double>::quiet_NaN();
+  Matrix6X J(6, model.nq());
+  point_jacobian(model, data, body, data.X_WB[static_cast<std::size_t>(body)].translation, J);
+  // Columns 1..l (Remark 1: the others are zero for a chain).
+  Eigen::JacobiSVD<MatrixX> svd(J.leftCols(body));
+  const auto& sv = svd.singularValues();
+  const double smin = sv[sv.size() - 1];
+  return smin > 0.0 ? sv[0] / smin : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace extwrench

@@ -42,16 +42,16 @@ double point_line_distance(const Vector3& p, const Vector3& a, const Vector3& u)
 
 MetricsAccumulator::MetricsAccumulator(MetricsWindow window) { m_.window = std::move(window); }
 
-void MetricsAccumulator::add(double t, const TruthSample& truth,
-                             const EstimateSample& est) noexcept {
+void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate& est) noexcept {
+  const bool touched = truth.body >= 0;
   // Detection delay, over the whole log: onset = first sample of a contact.
-  if (truth.contact && !in_contact_) {
+  if (touched && !in_contact_) {
     ++m_.onsets;
     onset_t_ = t;
     waiting_detection_ = true;
   }
-  in_contact_ = truth.contact;
-  if (!truth.contact) waiting_detection_ = false;
+  in_contact_ = touched;
+  if (!touched) waiting_detection_ = false;
   if (waiting_detection_ && est.contact) {
     const double delay = t - onset_t_;
     ++m_.onsets_detected;
@@ -63,22 +63,22 @@ void MetricsAccumulator::add(double t, const TruthSample& truth,
   if (!m_.window.contains(t)) return;
   ++m_.samples;
   // Force and moment errors: no detection means F̂ = 0, M̂ = 0; free means F = 0, M = 0.
-  const Vector3 f_true = truth.contact ? truth.force : Vector3::Zero();
-  const Vector3 m_true = truth.contact ? truth.moment : Vector3::Zero();
+  const Vector3 f_true = touched ? truth.force : Vector3::Zero();
+  const Vector3 m_true = touched ? truth.moment : Vector3::Zero();
   if (!est.contact) {
     m_.force.add(f_true.norm());
-  } else if (est.has_force) {
-    m_.force.add((est.force - f_true).norm());
+  } else if (est.has(EstimateFlag::kForce)) {
+    m_.force.add((est.force_W - f_true).norm());
   } else {
     ++m_.force_not_estimated;
   }
   if (!est.contact) {
     m_.moment.add(m_true.norm());
-  } else if (est.has_moment) {
-    m_.moment.add((est.moment - m_true).norm());
+  } else if (est.has(EstimateFlag::kMoment)) {
+    m_.moment.add((est.moment_W - m_true).norm());
   }
 
-  if (!truth.contact) {
+  if (!touched) {
     ++m_.free_samples;
     if (est.contact) ++m_.false_alarms;
     return;
@@ -87,16 +87,16 @@ void MetricsAccumulator::add(double t, const TruthSample& truth,
   ++m_.contact_samples;
   if (!est.contact) {
     ++m_.missed;
-  } else if (est.body == truth.body) {
+  } else if (est.link == truth.body) {
     ++m_.right_link;
   }
-  if (est.contact && est.has_line) {
-    m_.line.add(point_line_distance(truth.point, est.line_point, est.line_direction));
+  if (est.contact && est.has(EstimateFlag::kLineOfAction)) {
+    m_.line.add(point_line_distance(truth.point, est.line_point_W, est.line_direction_W));
   } else {
     ++m_.line_not_estimated;
   }
-  if (est.contact && est.has_surface_point)
-    m_.surface.add((est.surface_point - truth.point).norm());
+  if (est.contact && est.has(EstimateFlag::kSurfacePoint))
+    m_.surface.add((est.point_W - truth.point).norm());
 }
 
 Metrics MetricsAccumulator::result() const { return m_; }

@@ -1,6 +1,8 @@
 # The packaging test (ctest runs it with cmake -P): install the build tree into a temporary
 # prefix, configure and build tests/packaging/consumer against it with find_package(extwrench),
-# run the consumers, and check the installed CLI and model files.
+# one consumer per target (core, io, app; the consumer's CMakeLists checks that the core links
+# Eigen only and io neither Threads nor gnuplot), run them, and check the installed CLI and
+# model files.
 #
 # Inputs: BUILD_DIR, CONSUMER_DIR, WORK_DIR, CXX_COMPILER, SANITIZE (ON when the build uses
 # the sanitizers: the consumer must then link their runtimes too), HAVE_CLI (1 when the
@@ -27,6 +29,7 @@ endfunction()
 run_step("install" ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 
 set(expected include/extwrench/dynamics/rnea.hpp include/extwrench/io/csv.hpp
+    include/extwrench/app/replay.hpp
     share/extwrench/models/paper_arm.urdf share/extwrench/models/paper_arm.yaml)
 if(HAVE_CLI)
   list(APPEND expected bin/extwrench)
@@ -49,10 +52,11 @@ endif()
 run_step("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${consumer_build}
          -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
          -DCMAKE_BUILD_TYPE=Release ${flags})
-run_step("build the consumer" ${CMAKE_COMMAND} --build ${consumer_build})
-run_step("core-only consumer" ${consumer_build}/consumer_core)
-run_step("io consumer on the installed URDF" ${consumer_build}/consumer_io ${prefix}/share/extwrench/models/paper_arm.urdf)
-run_step("io consumer on the installed DH table" ${consumer_build}/consumer_io ${prefix}/share/extwrench/models/paper_arm.yaml)
+run_step("build the consumer" ${CMAKE_COMMAND} --build ${consumer_build} --parallel 2)
+run_step("core-only consumer" ${consumer_build}/core/consumer_core)
+run_step("io consumer on the installed URDF" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.urdf)
+run_step("io consumer on the installed DH table" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.yaml)
+run_step("app consumer (replay_log)" ${consumer_build}/app/consumer_app ${prefix}/share/extwrench/models/paper_arm.urdf ${WORK_DIR}/app_out)
 if(HAVE_CLI)
   run_step("installed CLI" ${prefix}/bin/extwrench info ${prefix}/share/extwrench/models/paper_arm.yaml)
 endif()

@@ -13,11 +13,11 @@
 #include <functional>
 #include <sstream>
 
+#include "extwrench/app/scenario_run.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/log.hpp"
 #include "extwrench/io/robot_loader.hpp"
-#include "extwrench/io/scenario.hpp"
 #include "extwrench/io/urdf_writer.hpp"
 #include "extwrench/sim/perturb.hpp"
 #include "support/random.hpp"

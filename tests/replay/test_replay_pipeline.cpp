@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "extwrench/app/replay.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/log.hpp"
-#include "extwrench/io/replay.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "support/random.hpp"
 

@@ -350,24 +350,22 @@ TEST(Simulator, BaseReadingEqualsWeightPlusForceForARobotHeldAtRest) {
 
 TEST(Metrics, AccumulatesErrorsInsideTheWindowOnly) {
   MetricsAccumulator acc(MetricsWindow{.from = 1.0, .to = 3.0, .exclude = {{1.5, 2.0}}});
-  TruthSample truth{.contact = true,
-                    .body = 4,
-                    .contacts = 1,
-                    .force = Vector3(10, 0, 0),
-                    .moment = Vector3::Zero(),
-                    .point = Vector3(0, 0, 1)};
-  EstimateSample est;
+  Truth truth;
+  truth.body = 4;
+  truth.contacts = 1;
+  truth.force = Vector3(10, 0, 0);
+  truth.point = Vector3(0, 0, 1);
+  ContactEstimate est;
   est.contact = true;
-  est.body = 4;
-  est.has_force = true;
-  est.force = Vector3(13, 4, 0);  // error 5
-  est.has_line = true;
-  est.line_point = Vector3(0.5, 0, 0);
-  est.line_direction = Vector3(0, 0, 1);  // distance 0.5
+  est.link = 4;
+  est.flags = EstimateFlag::kContact | EstimateFlag::kForce | EstimateFlag::kLineOfAction;
+  est.force_W = Vector3(13, 4, 0);  // error 5
+  est.line_point_W = Vector3(0.5, 0, 0);
+  est.line_direction_W = Vector3(0, 0, 1);  // distance 0.5
   for (int k = 0; k <= 40; ++k) {
     const double t = 0.1 * k;
-    EstimateSample e = est;
-    if (t > 2.45 && t < 2.55) e.body = 3;  // one wrong link
+    ContactEstimate e = est;
+    if (t > 2.45 && t < 2.55) e.link = 3;  // one wrong link
     acc.add(t, truth, e);
   }
   const Metrics m = acc.result();
@@ -382,18 +380,16 @@ TEST(Metrics, AccumulatesErrorsInsideTheWindowOnly) {
 
 TEST(Metrics, CountsFalseAlarmsMissesAndDetectionDelay) {
   MetricsAccumulator acc(MetricsWindow{});
-  TruthSample free_truth;
-  TruthSample contact{.contact = true,
-                      .body = 2,
-                      .contacts = 1,
-                      .force = Vector3(0, 0, 3),
-                      .moment = Vector3::Zero(),
-                      .point = Vector3::Zero()};
-  EstimateSample none, alarm;
+  Truth free_truth;  // body -1: free
+  Truth contact;
+  contact.body = 2;
+  contact.contacts = 1;
+  contact.force = Vector3(0, 0, 3);
+  ContactEstimate none, alarm;
   alarm.contact = true;
-  alarm.body = 2;
-  alarm.has_force = true;
-  alarm.force = Vector3(0, 0, 3);
+  alarm.link = 2;
+  alarm.flags = EstimateFlag::kContact | EstimateFlag::kForce;
+  alarm.force_W = Vector3(0, 0, 3);
   acc.add(0.0, free_truth, alarm);  // false alarm, error 3
   acc.add(0.1, contact, none);      // onset, missed, error 3
   acc.add(0.2, contact, none);      // missed

@@ -29,4 +29,10 @@ void point_jacobian(const Model& model, const Data& data, int body, const Vector
 /// Jacobian of the body frame's origin (point_jacobian at the body origin), into data.J.
 const Matrix6X& body_jacobian(const Model& model, Data& data, int body);
 
+/// cond(J) = σ_max / σ_min of J (6 × l), the Jacobian of the origin O_l of body l, world frame,
+/// SI units: the "condition number of J of O_6" of the paper's Fig. 10 when l = 6. After
+/// forward_kinematics; NaN for body <= 0, +inf when J is singular. Allocates (an SVD): not for
+/// the real-time path.
+[[nodiscard]] double jacobian_condition(const Model& model, const Data& data, int body);
+
 }  // namespace extwrench

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "extwrench/core/types.hpp"
+#include "extwrench/estimation/contact_estimate.hpp"
+#include "extwrench/sim/sample.hpp"
 
 namespace extwrench::sim {
 
@@ -16,31 +18,6 @@ struct MetricsWindow {
   double to = std::numeric_limits<double>::infinity();
   std::vector<std::pair<double, double>> exclude;
   [[nodiscard]] bool contains(double t) const noexcept;
-};
-
-/// What the estimator said at a sample (world frame). Flags say which quantities it produced.
-struct EstimateSample {
-  bool contact = false;
-  int body = -1;
-  bool has_force = false;
-  Vector3 force = Vector3::Zero();
-  bool has_moment = false;
-  Vector3 moment = Vector3::Zero();
-  bool has_line = false;
-  Vector3 line_point = Vector3::Zero();      ///< p̂ of eq. (20)
-  Vector3 line_direction = Vector3::Zero();  ///< unit F̂ / ‖F̂‖
-  bool has_surface_point = false;
-  Vector3 surface_point = Vector3::Zero();
-};
-
-/// The truth at a sample (world frame).
-struct TruthSample {
-  bool contact = false;
-  int body = -1;
-  int contacts = 0;
-  Vector3 force = Vector3::Zero();
-  Vector3 moment = Vector3::Zero();
-  Vector3 point = Vector3::Zero();
 };
 
 /// RMS and max of an error over the samples where it was evaluated.
@@ -86,7 +63,9 @@ struct Metrics {
 class MetricsAccumulator {
  public:
   explicit MetricsAccumulator(MetricsWindow window);
-  void add(double t, const TruthSample& truth, const EstimateSample& estimate) noexcept;
+  /// One sample: the truth (in contact when truth.body >= 0) and what the estimator said (its
+  /// flags say which quantities it produced; world frame).
+  void add(double t, const Truth& truth, const ContactEstimate& estimate) noexcept;
   [[nodiscard]] Metrics result() const;
 
  private:

@@ -1,4 +1,4 @@
-#include "extwrench/io/plot.hpp"
+#include "extwrench/app/gnuplot.hpp"
 
 #include <sys/wait.h>
 

@@ -51,9 +51,4 @@ struct ReplayResult {
 ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator, const ReplayOptions& options);
 
-/// cond(J) = σ_max / σ_min of J (6 × l) of the origin O_l of body l, world frame, SI units:
-/// the "condition number of J of O_6" of the paper's Fig. 10 when l = 6. After forward
-/// kinematics on `data`; allocates (an SVD): not for the real-time path.
-[[nodiscard]] double origin_jacobian_condition(const Model& model, const Data& data, int body);
-
 }  // namespace extwrench

@@ -1,4 +1,5 @@
-// Simulation scenarios (YAML, docs/simulation.md) and running them: `extwrench simulate`.
+// Simulation scenarios (YAML, docs/simulation.md): the file format. Running them is
+// app/scenario_run.hpp (`extwrench simulate`).
 //
 // A scenario names the robot, the desired trajectory and the controller, the forces, the sensor
 // models, the seeds and the dynamic-parameter error, and one or more estimator configurations
@@ -10,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "extwrench/io/replay.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/sim/simulator.hpp"
 
@@ -49,31 +49,9 @@ struct Scenario {
 [[nodiscard]] Scenario load_scenario(const std::filesystem::path& path,
                                      const LoadOptions& robot_options = {});
 
-struct SchemeResult {
-  std::string name;
-  ReplayResult replay;
-};
-
-struct SeedResult {
-  std::uint64_t seed = 0;
-  std::filesystem::path dir;
-  long samples = 0;
-  double peak_condition = 0.0;  ///< max of cond(J of O_l) over the run (true q)
-  double peak_time = 0.0;       ///< [s]
-  std::vector<SchemeResult> schemes;
-};
-
-struct RunOptions {
-  bool figures = true;
-  bool progress = false;
-};
-
-/// Runs the scenario for every seed: DIR (one seed) or DIR/seed_<s> (several) receives
-/// log.csv, model_estimator.urdf, and per scheme <scheme>/config.yaml, estimates.csv,
-/// metrics.json and figures. The estimates come from replaying log.csv through the same code
-/// as `extwrench estimate`, with the configuration read back from <scheme>/config.yaml.
-[[nodiscard]] std::vector<SeedResult> run_scenario(const Scenario& scenario,
-                                                   const std::filesystem::path& out_dir,
-                                                   const RunOptions& options);
+/// The scheme's estimator configuration file (docs/config.md) for a run of the scenario: the
+/// scheme's own keys, plus `robot: ../model_estimator.urdf` (the perturbed model written next to
+/// the log), gravity, and the simulated sensor's pose when the scheme does not give one.
+[[nodiscard]] std::string scheme_config_yaml(const Scenario& scenario, const SchemeSpec& scheme);
 
 }  // namespace extwrench

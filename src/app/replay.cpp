@@ -1,9 +1,8 @@
-#include "extwrench/io/replay.hpp"
+#include "extwrench/app/replay.hpp"
 
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <Eigen/SVD>
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -19,10 +18,10 @@
 #include <sstream>
 #include <thread>
 
+#include "extwrench/app/gnuplot.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/io/log.hpp"
-#include "extwrench/io/plot.hpp"
 
 namespace extwrench {
 namespace {
@@ -270,33 +269,6 @@ enum Col : int {
   kErrF,
   kQ  // q1..qn follow
 };
-
-sim::TruthSample truth_of(const sim::Sample& s) {
-  sim::TruthSample t;
-  t.contact = s.truth.body >= 0;
-  t.body = s.truth.body;
-  t.contacts = s.truth.contacts;
-  t.force = s.truth.force;
-  t.moment = s.truth.moment;
-  t.point = s.truth.point;
-  return t;
-}
-
-sim::EstimateSample estimate_of(const ContactEstimate& e) {
-  sim::EstimateSample s;
-  s.contact = e.contact;
-  s.body = e.link;
-  s.has_force = e.has(EstimateFlag::kForce);
-  s.force = e.force_W;
-  s.has_moment = e.has(EstimateFlag::kMoment);
-  s.moment = e.moment_W;
-  s.has_line = e.has(EstimateFlag::kLineOfAction);
-  s.line_point = e.line_point_W;
-  s.line_direction = e.line_direction_W;
-  s.has_surface_point = e.has(EstimateFlag::kSurfacePoint);
-  s.surface_point = e.point_W;
-  return s;
-}
 
 class Progress {
  public:
@@ -548,17 +520,6 @@ std::vector<std::filesystem::path> make_figures(const Model& model, const Decima
 
 }  // namespace
 
-double origin_jacobian_condition(const Model& model, const Data& data, int body) {
-  if (body <= 0) return kNaN;
-  Matrix6X J(6, model.nq());
-  point_jacobian(model, data, body, data.X_WB[static_cast<std::size_t>(body)].translation, J);
-  // Columns 1..l (Remark 1: the others are zero for a chain).
-  Eigen::JacobiSVD<MatrixX> svd(J.leftCols(body));
-  const auto& sv = svd.singularValues();
-  const double smin = sv[sv.size() - 1];
-  return smin > 0.0 ? sv[0] / smin : std::numeric_limits<double>::infinity();
-}
-
 ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator_options, const ReplayOptions& o) {
   LogReader reader(o.log, model);
@@ -626,9 +587,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     t_end = s.t;
     ++result.rows;
     if (layout.truth) {
-      const sim::TruthSample truth = truth_of(s);
-      const sim::EstimateSample est = estimate_of(*e);
-      for (auto& acc : accumulators) acc.add(s.t, truth, est);
+      for (auto& acc : accumulators) acc.add(s.t, s.truth, *e);
     }
     if (o.figures) {
       if (dec.wants_next()) {
@@ -649,7 +608,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
         r[kCondTrue] = kNaN;
         if (layout.truth && s.truth.body > 0) {
           forward_kinematics(model, plot_data, s.q);
-          r[kCondTrue] = origin_jacobian_condition(model, plot_data, s.truth.body);
+          r[kCondTrue] = jacobian_condition(model, plot_data, s.truth.body);
         }
         r[kErrF] = kNaN;
         if (layout.truth) {
