@@ -27,7 +27,7 @@ struct Scenario {
   std::filesystem::path robot_path;
   RobotDescription robot;
   std::vector<std::uint64_t> seeds{1};
-  double model_error = 0.01;         ///< ± fraction of every dynamic parameter (SPEC 5)
+  double model_error = 0.01;  ///< ± fraction of every dynamic parameter (docs/simulation.md)
   sim::SimulationConfig simulation;  ///< forces, sensors, duration, steps (noise seed per run)
   sim::SinusoidalTrajectory trajectory;
   sim::PidGains gains;

@@ -1,5 +1,5 @@
-// Accuracy metrics of an estimator against the truth (SPEC 6), accumulated sample by sample in
-// constant memory, over a stated time window.
+// Accuracy metrics of an estimator against the truth (docs/log_format.md, metrics.json),
+// accumulated sample by sample in constant memory, over a stated time window.
 #pragma once
 
 #include <limits>
