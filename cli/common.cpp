@@ -7,7 +7,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
-#include "extwrench/io/csv.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench::cli {
 
@@ -23,7 +23,7 @@ Pose parse_pose(const std::string& text, const std::string& option) {
   const auto take = [&]() {
     if (token.empty()) return;
     if (count == values.size()) throw fail("more than six numbers");
-    const auto value = parse_number(token);  // the CSV reader's strict rules
+    const auto value = parse_number(token);
     if (!value) throw fail("'" + token + "' is not a finite number");
     values[count++] = *value;
     token.clear();

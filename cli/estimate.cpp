@@ -9,6 +9,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/csv.hpp"
 #include "extwrench/io/estimator_config.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench::cli {
 namespace {

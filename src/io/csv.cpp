@@ -17,6 +17,7 @@
 #endif
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
 namespace {
@@ -39,37 +40,7 @@ std::string shown(std::string_view cell) {
   return std::string(cell.substr(0, kShownCellChars)) + "...";
 }
 
-enum class ParseResult { kOk, kNotANumber, kOutOfRange };
-
-ParseResult parse_strict(std::string_view s, double& value) {
-  if (s.empty()) return ParseResult::kNotANumber;
-  const char* p = s.data();
-  const char* const end = s.data() + s.size();
-  if (*p == '+') {  // from_chars rejects a leading '+', which other tools write
-    ++p;
-    if (p != end && (*p == '+' || *p == '-')) return ParseResult::kNotANumber;
-  }
-  const auto [ptr, ec] = std::from_chars(p, end, value);
-  if (ec == std::errc::result_out_of_range) return ParseResult::kOutOfRange;
-  if (ec != std::errc() || ptr != end) return ParseResult::kNotANumber;
-  return ParseResult::kOk;
-}
-
-// The common case of a cell, a finite number without a leading '+', in one call: what both
-// number() and number_or_nan() return as is (parse() handles everything else).
-bool plain_number(std::string_view s, double& value) {
-  if (s.empty() || s.front() == '+') return false;
-  const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
-  return ec == std::errc() && ptr == s.data() + s.size() && std::isfinite(value);
-}
-
 }  // namespace
-
-std::optional<double> parse_number(std::string_view text) {
-  double value = 0.0;
-  if (parse_strict(text, value) != ParseResult::kOk || !std::isfinite(value)) return std::nullopt;
-  return value;
-}
 
 // ------------------------------------------------------------------------------------------
 // CsvReader
@@ -302,11 +273,11 @@ double CsvReader::parse(int column, bool allow_missing) const {
     fail_number(column, "empty cell, expected a number");
   }
   double value = 0.0;
-  const ParseResult result = parse_strict(s, value);
-  if (result == ParseResult::kOutOfRange) {
+  const NumberScan result = scan_number(s, value);
+  if (result == NumberScan::kOutOfRange) {
     fail_number(column, "number out of the range of a double: '" + shown(s) + "'");
   }
-  if (result != ParseResult::kOk) fail_number(column, "expected a number, got '" + shown(s) + "'");
+  if (result != NumberScan::kOk) fail_number(column, "expected a number, got '" + shown(s) + "'");
   if (std::isnan(value)) {
     if (allow_missing) return std::numeric_limits<double>::quiet_NaN();
     fail_number(column, "expected a finite number, got '" + shown(s) + "'");
@@ -320,7 +291,7 @@ double CsvReader::parse(int column, bool allow_missing) const {
 double CsvReader::number(int column) const {
   double value = 0.0;
   if (static_cast<std::size_t>(column) < cells_.size() &&
-      plain_number(cells_[static_cast<std::size_t>(column)], value)) {
+      parse_plain_number(cells_[static_cast<std::size_t>(column)], value)) {
     return value;
   }
   return parse(column, false);  // the rest, with messages that name what is wrong
@@ -329,7 +300,7 @@ double CsvReader::number(int column) const {
 double CsvReader::number_or_nan(int column) const {
   double value = 0.0;
   if (static_cast<std::size_t>(column) < cells_.size() &&
-      plain_number(cells_[static_cast<std::size_t>(column)], value)) {
+      parse_plain_number(cells_[static_cast<std::size_t>(column)], value)) {
     return value;
   }
   return parse(column, true);
@@ -363,18 +334,9 @@ CsvWriter::~CsvWriter() {
   }
 }
 
-void CsvWriter::append(std::string& out, double value) {
-  std::array<char, 32> text{};  // the shortest form of a double has at most 24 characters
-  const auto [ptr, ec] = std::to_chars(text.data(), text.data() + text.size(), value);
-  (void)ec;  // cannot fail with 32 characters
-  out.append(text.data(), ptr);
-}
+void CsvWriter::append(std::string& out, double value) { append_number(out, value); }
 
-std::string CsvWriter::format(double value) {
-  std::string s;
-  append(s, value);
-  return s;
-}
+std::string CsvWriter::format(double value) { return format_number(value); }
 
 char* CsvWriter::room(std::size_t bytes) {
   if (size_ + bytes > capacity_) grow(size_ + bytes);

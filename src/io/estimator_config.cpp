@@ -2,141 +2,163 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
-#include <fstream>
-#include <set>
 #include <sstream>
 
+#include "detail/yaml_reader.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/model/model_builder.hpp"
 
 namespace extwrench {
 namespace {
 
+namespace fs = std::filesystem;
+using io_detail::non_negative;
+using io_detail::positive;
+using io_detail::Range;
+using io_detail::YamlReader;
+
 constexpr int kDefaultTareSamples = 100;
 
-/// Reads typed values out of YAML nodes; every error names file, line and key.
-class Reader {
- public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& key,
-                         const std::string& what) const {
-    std::ostringstream o;
-    o << file_;
-    if (node.IsDefined() && node.Mark().line >= 0) o << ':' << node.Mark().line + 1;
-    o << ": " << key << ": " << what;
-    throw Error(o.str());
-  }
-
-  /// Throws for keys of `map` outside `allowed`.
-  void only_keys(const YAML::Node& map, const std::string& prefix,
-                 std::initializer_list<const char*> allowed) const {
-    if (!map.IsMap()) fail(map, prefix.empty() ? "(top level)" : prefix, "expected a mapping");
-    std::set<std::string> ok(allowed.begin(), allowed.end());
-    for (const auto& kv : map) {
-      const std::string k = kv.first.as<std::string>();
-      if (ok.count(k) == 0) {
-        std::string list;
-        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        fail(kv.first, prefix.empty() ? k : prefix + "." + k,
-             "unknown key (expected one of: " + list + ")");
-      }
+void read_sensor(const YamlReader& rd, const YAML::Node& sensor, SensorOptions& o) {
+  rd.only_keys(sensor, "sensor", {"type", "pose", "tare"});
+  if (!sensor["type"]) rd.fail(sensor, "sensor.type", "missing (ft | force | none)");
+  o.type = rd.sensor_type(sensor["type"], "sensor.type");
+  if (sensor["pose"]) o.pose = rd.pose(sensor["pose"], "sensor.pose");
+  if (const YAML::Node t = sensor["tare"]) {
+    if (YamlReader::is_boolean(t)) {
+      o.tare_samples = rd.boolean(t, "sensor.tare") ? kDefaultTareSamples : 0;
+    } else {
+      o.tare_samples = static_cast<int>(
+          rd.integer(t, "sensor.tare", {0, 1e9, false, "of samples >= 0 (or true / false)"}));
     }
   }
+}
 
-  std::string string(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsScalar()) fail(node, key, "expected a string");
-    return node.Scalar();
-  }
-
-  double number(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsScalar()) fail(node, key, "expected a number");
-    const std::string& s = node.Scalar();
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v)) {
-      fail(node, key, "expected a finite number, got '" + s + "'");
+void read_contact(const YamlReader& rd, const YAML::Node& c, const Model& model,
+                  ContactOptions& o) {
+  rd.only_keys(c, "contact", {"model", "link", "point"});
+  const bool known_point =
+      c["model"] && rd.one_of(c["model"], "contact.model", {"pure_force", "known_point"}) == 1;
+  if (!known_point) {
+    o.model = ContactModel::kPureForce;
+    if (c["link"] || c["point"]) {
+      rd.fail(c["link"] ? c["link"] : c["point"], c["link"] ? "contact.link" : "contact.point",
+              "only used with contact.model: known_point");
     }
-    return v;
+    return;
   }
+  o.model = ContactModel::kKnownPoint;
+  if (!c["link"]) rd.fail(c, "contact.link", "missing (required with contact.model: known_point)");
+  o.link = rd.body(model, c["link"], "contact.link");
+  if (c["point"]) o.point = rd.vector3(c["point"], "contact.point");
+}
 
-  double number_in(const YAML::Node& node, const std::string& key, double lo, double hi,
-                   bool lo_open, const std::string& range) const {
-    const double v = number(node, key);
-    if ((lo_open ? !(v > lo) : !(v >= lo)) || !(v <= hi)) {
-      fail(node, key, "expected a value " + range + ", got " + node.Scalar());
+void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorOptions& o) {
+  rd.only_keys(ob, "observer", {"gain"});
+  const Range gain = positive();
+  if (ob["gain"]) o.observer_gain = rd.vector(ob["gain"], "observer.gain", n, &gain);
+}
+
+void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionOptions& o) {
+  rd.only_keys(d, "detection", {"tau_min", "f_min", "release_ratio", "min_duration"});
+  const Range tau_min = positive();
+  if (d["tau_min"]) o.tau_min = rd.vector(d["tau_min"], "detection.tau_min", n, &tau_min);
+  if (d["f_min"]) o.f_min = rd.number_in(d["f_min"], "detection.f_min", {0, 1e12, true, "> 0 [N]"});
+  if (d["release_ratio"]) {
+    o.release_ratio =
+        rd.number_in(d["release_ratio"], "detection.release_ratio", {0, 1, true, "in (0, 1]"});
+  }
+  if (d["min_duration"]) {
+    o.min_duration =
+        rd.number_in(d["min_duration"], "detection.min_duration", {0, 1e6, false, ">= 0 [s]"});
+  }
+}
+
+// Either a route (acceleration: residual) or a mapping {route, cutoff}.
+void read_acceleration(const YamlReader& rd, const YAML::Node& a, EstimatorOptions& o) {
+  if (a.IsMap()) {
+    rd.only_keys(a, "acceleration", {"route", "cutoff"});
+    if (!a["route"]) rd.fail(a, "acceleration.route", "missing (residual | differentiation)");
+    if (a["cutoff"]) {
+      o.differentiation_cutoff =
+          rd.number_in(a["cutoff"], "acceleration.cutoff", {0, 1e9, true, "> 0 [Hz]"});
     }
-    return v;
   }
+  // (a fresh handle: assigning to a YAML::Node would overwrite the node it refers to)
+  const YAML::Node route = a.IsMap() ? a["route"] : a;
+  const std::size_t r = rd.one_of(route, a.IsMap() ? "acceleration.route" : "acceleration",
+                                  {"residual", "differentiation"});
+  o.acceleration = r == 0 ? AccelerationRoute::kResidual : AccelerationRoute::kDifferentiation;
+}
 
-  bool boolean(const YAML::Node& node, const std::string& key, bool& out) const {
-    if (!node.IsScalar()) return false;
-    const std::string& s = node.Scalar();
-    if (s == "true" || s == "True" || s == "yes") return out = true, true;
-    if (s == "false" || s == "False" || s == "no") return out = false, true;
-    (void)key;
-    return false;
-  }
-
-  Vector3 vector3(const YAML::Node& node, const std::string& key) const {
-    if (!node.IsSequence() || node.size() != 3) fail(node, key, "expected a list of 3 numbers");
-    Vector3 v;
-    for (int i = 0; i < 3; ++i) v[i] = number(node[i], key + "[" + std::to_string(i) + "]");
-    return v;
-  }
-
-  /// A number for every joint, or a list of n numbers; each > 0 (or ≥ 0 when `allow_zero`).
-  VectorX per_joint(const YAML::Node& node, const std::string& key, int n, bool allow_zero) const {
-    auto check = [&](const YAML::Node& nd, const std::string& k) {
-      const double v = number(nd, k);
-      if (allow_zero ? v < 0.0 : !(v > 0.0))
-        fail(nd, k,
-             std::string("expected a value ") + (allow_zero ? ">= 0" : "> 0") + ", got " +
-                 nd.Scalar());
-      return v;
-    };
-    if (node.IsScalar()) return VectorX::Constant(n, check(node, key));
-    if (!node.IsSequence())
-      fail(node, key, "expected a number or a list of " + std::to_string(n) + " numbers");
-    if (static_cast<int>(node.size()) != n) {
-      fail(node, key,
-           "expected " + std::to_string(n) + " values (one per joint), got " +
-               std::to_string(node.size()));
+// "model" (the robot file's), "none", or a mapping {viscous, coulomb, smoothing_velocity}.
+void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOptions& o) {
+  if (f.IsScalar()) {
+    const std::string s = f.Scalar();
+    if (s == "none") {
+      o.friction = JointFriction::none(n);
+    } else if (s != "model") {
+      rd.fail(f, "friction",
+              "expected model, none or a mapping {viscous, coulomb, smoothing_velocity}, got '" +
+                  s + "'");
     }
-    VectorX v(n);
-    for (int i = 0; i < n; ++i) v[i] = check(node[i], key + "[" + std::to_string(i) + "]");
-    return v;
+    return;
   }
-
-  int body(const Model& model, const YAML::Node& node, const std::string& key) const {
-    const std::string name = string(node, key);
-    const std::optional<int> b = model.find_body(name);
-    if (!b) fail(node, key, "no link named '" + name + "' in robot '" + model.name + "'");
-    return *b;
+  rd.only_keys(f, "friction", {"viscous", "coulomb", "smoothing_velocity"});
+  JointFriction jf = JointFriction::none(n);
+  const Range coefficient = non_negative();
+  if (f["viscous"]) jf.viscous = rd.vector(f["viscous"], "friction.viscous", n, &coefficient);
+  if (f["coulomb"]) jf.coulomb = rd.vector(f["coulomb"], "friction.coulomb", n, &coefficient);
+  if (f["smoothing_velocity"]) {
+    jf.smoothing_velocity =
+        rd.number_in(f["smoothing_velocity"], "friction.smoothing_velocity", {0, 1e9, true, "> 0"});
   }
+  o.friction = jf;
+}
 
-  const std::string& file() const { return file_; }
+void read_payload(const YamlReader& rd, const YAML::Node& p, const Model& model,
+                  EstimatorOptions& o) {
+  rd.only_keys(p, "payload", {"link", "mass", "com", "inertia"});
+  if (!p["link"]) rd.fail(p, "payload.link", "missing");
+  if (!p["mass"]) rd.fail(p, "payload.mass", "missing");
+  PayloadOptions pl;
+  pl.body = rd.body(model, p["link"], "payload.link");
+  pl.inertia.mass = rd.number_in(p["mass"], "payload.mass", {0, 1e9, false, ">= 0 [kg]"});
+  if (p["com"]) pl.inertia.com = rd.vector3(p["com"], "payload.com");
+  if (const YAML::Node in = p["inertia"]) {
+    if (!in.IsSequence() || in.size() != 6)
+      rd.fail(in, "payload.inertia", "expected [ixx, ixy, ixz, iyy, iyz, izz] [kg m^2]");
+    double v[6];
+    for (std::size_t i = 0; i < 6; ++i)
+      v[i] = rd.number(in[i], YamlReader::item("payload.inertia", i));
+    pl.inertia.inertia_com << v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5];
+    try {
+      validate_inertia(pl.inertia, "payload");
+    } catch (const Error& e) {
+      rd.fail(in, "payload.inertia", e.what());
+    }
+  }
+  o.payload = pl;
+}
 
- private:
-  std::string file_;
-};
+void read_solver(const YamlReader& rd, const YAML::Node& s, SolverOptions& o) {
+  rd.only_keys(s, "solver", {"max_condition", "rank_tolerance"});
+  if (s["max_condition"]) {
+    o.max_condition =
+        rd.number_in(s["max_condition"], "solver.max_condition", {1, 1e300, true, "> 1"});
+  }
+  if (s["rank_tolerance"]) {
+    o.rank_tolerance =
+        rd.number_in(s["rank_tolerance"], "solver.rank_tolerance", {0, 1, true, "in (0, 1)"});
+  }
+}
 
-EstimatorConfig interpret(const YAML::Node& root, const std::filesystem::path& source,
-                          LoadOptions robot_options) {
-  const Reader rd(source.string());
-  if (!root.IsDefined() || root.IsNull()) rd.fail(root, "(top level)", "empty configuration");
-  rd.only_keys(root, "",
-               {"robot", "gravity", "sensor", "contact", "observer", "detection", "acceleration",
-                "friction", "payload", "solver"});
-  EstimatorConfig cfg;
-  cfg.source = source;
+// The robot file, relative to the configuration, loaded with the configuration's gravity.
+void read_robot(const YamlReader& rd, const YAML::Node& root, const fs::path& source,
+                LoadOptions robot_options, EstimatorConfig& cfg) {
   if (!root["robot"])
     rd.fail(root, "robot", "missing (path of the URDF or DH YAML, relative to this file)");
-  const std::filesystem::path robot_rel = rd.string(root["robot"], "robot");
+  const fs::path robot_rel = rd.string(root["robot"], "robot");
   cfg.robot_path = robot_rel.is_absolute() ? robot_rel : source.parent_path() / robot_rel;
   if (root["gravity"]) robot_options.gravity = rd.vector3(root["gravity"], "gravity");
   try {
@@ -145,181 +167,31 @@ EstimatorConfig interpret(const YAML::Node& root, const std::filesystem::path& s
     rd.fail(root["robot"], "robot",
             std::string("cannot load '") + cfg.robot_path.string() + "': " + e.what());
   }
+}
+
+EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
+                          const LoadOptions& robot_options) {
+  const YamlReader rd(source.string());
+  if (!root.IsDefined() || root.IsNull()) rd.fail(root, "(top level)", "empty configuration");
+  rd.only_keys(root, "",
+               {"robot", "gravity", "sensor", "contact", "observer", "detection", "acceleration",
+                "friction", "payload", "solver"});
+  EstimatorConfig cfg;
+  cfg.source = source;
+  read_robot(rd, root, source, robot_options, cfg);
   const Model& model = cfg.robot.model;
   const int n = model.nq();
   EstimatorOptions& o = cfg.options;
-
-  // sensor
   if (!root["sensor"])
     rd.fail(root, "sensor", "missing (needs at least sensor.type: ft | force | none)");
-  const YAML::Node sensor = root["sensor"];
-  rd.only_keys(sensor, "sensor", {"type", "pose", "tare"});
-  if (!sensor["type"]) rd.fail(sensor, "sensor.type", "missing (ft | force | none)");
-  const std::string type = rd.string(sensor["type"], "sensor.type");
-  if (type == "ft") {
-    o.sensor.type = SensorType::kForceTorque;
-  } else if (type == "force") {
-    o.sensor.type = SensorType::kForce;
-  } else if (type == "none") {
-    o.sensor.type = SensorType::kNone;
-  } else {
-    rd.fail(sensor["type"], "sensor.type", "expected one of ft, force, none, got '" + type + "'");
-  }
-  if (sensor["pose"]) {
-    const YAML::Node pose = sensor["pose"];
-    rd.only_keys(pose, "sensor.pose", {"xyz", "rpy"});
-    const Vector3 xyz = pose["xyz"] ? rd.vector3(pose["xyz"], "sensor.pose.xyz") : Vector3::Zero();
-    const Vector3 rpy = pose["rpy"] ? rd.vector3(pose["rpy"], "sensor.pose.rpy") : Vector3::Zero();
-    o.sensor.pose = Pose::from_xyz_rpy(xyz, rpy);
-  }
-  if (sensor["tare"]) {
-    const YAML::Node t = sensor["tare"];
-    bool b = false;
-    if (rd.boolean(t, "sensor.tare", b)) {
-      o.sensor.tare_samples = b ? kDefaultTareSamples : 0;
-    } else {
-      const double v = rd.number(t, "sensor.tare");
-      if (v < 0 || v != std::floor(v) || v > 1e9) {
-        rd.fail(t, "sensor.tare",
-                "expected true, false or a whole number of samples >= 0, got " + t.Scalar());
-      }
-      o.sensor.tare_samples = static_cast<int>(v);
-    }
-  }
-
-  // contact
-  if (root["contact"]) {
-    const YAML::Node c = root["contact"];
-    rd.only_keys(c, "contact", {"model", "link", "point"});
-    const std::string m = c["model"] ? rd.string(c["model"], "contact.model") : "pure_force";
-    if (m == "pure_force") {
-      o.contact.model = ContactModel::kPureForce;
-      if (c["link"] || c["point"]) {
-        rd.fail(c["link"] ? c["link"] : c["point"], c["link"] ? "contact.link" : "contact.point",
-                "only used with contact.model: known_point");
-      }
-    } else if (m == "known_point") {
-      o.contact.model = ContactModel::kKnownPoint;
-      if (!c["link"])
-        rd.fail(c, "contact.link", "missing (required with contact.model: known_point)");
-      o.contact.link = rd.body(model, c["link"], "contact.link");
-      if (c["point"]) o.contact.point = rd.vector3(c["point"], "contact.point");
-    } else {
-      rd.fail(c["model"], "contact.model", "expected pure_force or known_point, got '" + m + "'");
-    }
-  }
-
-  // observer
-  if (root["observer"]) {
-    const YAML::Node ob = root["observer"];
-    rd.only_keys(ob, "observer", {"gain"});
-    if (ob["gain"]) o.observer_gain = rd.per_joint(ob["gain"], "observer.gain", n, false);
-  }
-
-  // detection
-  if (root["detection"]) {
-    const YAML::Node d = root["detection"];
-    rd.only_keys(d, "detection", {"tau_min", "f_min", "release_ratio", "min_duration"});
-    if (d["tau_min"])
-      o.detection.tau_min = rd.per_joint(d["tau_min"], "detection.tau_min", n, false);
-    if (d["f_min"])
-      o.detection.f_min = rd.number_in(d["f_min"], "detection.f_min", 0, 1e12, true, "> 0 [N]");
-    if (d["release_ratio"]) {
-      o.detection.release_ratio =
-          rd.number_in(d["release_ratio"], "detection.release_ratio", 0, 1, true, "in (0, 1]");
-    }
-    if (d["min_duration"]) {
-      o.detection.min_duration =
-          rd.number_in(d["min_duration"], "detection.min_duration", 0, 1e6, false, ">= 0 [s]");
-    }
-  }
-
-  // acceleration
-  if (root["acceleration"]) {
-    const YAML::Node a = root["acceleration"];
-    if (a.IsMap()) {
-      rd.only_keys(a, "acceleration", {"route", "cutoff"});
-      if (!a["route"]) rd.fail(a, "acceleration.route", "missing (residual | differentiation)");
-      if (a["cutoff"])
-        o.differentiation_cutoff =
-            rd.number_in(a["cutoff"], "acceleration.cutoff", 0, 1e9, true, "> 0 [Hz]");
-    }
-    // (a fresh handle: assigning to a YAML::Node would overwrite the node it refers to)
-    const YAML::Node route = a.IsMap() ? a["route"] : a;
-    const std::string r = rd.string(route, a.IsMap() ? "acceleration.route" : "acceleration");
-    if (r == "residual") {
-      o.acceleration = AccelerationRoute::kResidual;
-    } else if (r == "differentiation") {
-      o.acceleration = AccelerationRoute::kDifferentiation;
-    } else {
-      rd.fail(route, "acceleration", "expected residual or differentiation, got '" + r + "'");
-    }
-  }
-
-  // friction
-  if (root["friction"]) {
-    const YAML::Node f = root["friction"];
-    if (f.IsScalar()) {
-      const std::string s = f.Scalar();
-      if (s == "none") {
-        o.friction = JointFriction::none(n);
-      } else if (s != "model") {
-        rd.fail(f, "friction",
-                "expected model, none or a mapping {viscous, coulomb, smoothing_velocity}, got '" +
-                    s + "'");
-      }
-    } else {
-      rd.only_keys(f, "friction", {"viscous", "coulomb", "smoothing_velocity"});
-      JointFriction jf = JointFriction::none(n);
-      if (f["viscous"]) jf.viscous = rd.per_joint(f["viscous"], "friction.viscous", n, true);
-      if (f["coulomb"]) jf.coulomb = rd.per_joint(f["coulomb"], "friction.coulomb", n, true);
-      if (f["smoothing_velocity"]) {
-        jf.smoothing_velocity = rd.number_in(f["smoothing_velocity"], "friction.smoothing_velocity",
-                                             0, 1e9, true, "> 0");
-      }
-      o.friction = jf;
-    }
-  }
-
-  // payload
-  if (root["payload"]) {
-    const YAML::Node p = root["payload"];
-    rd.only_keys(p, "payload", {"link", "mass", "com", "inertia"});
-    if (!p["link"]) rd.fail(p, "payload.link", "missing");
-    if (!p["mass"]) rd.fail(p, "payload.mass", "missing");
-    PayloadOptions pl;
-    pl.body = rd.body(model, p["link"], "payload.link");
-    pl.inertia.mass = rd.number_in(p["mass"], "payload.mass", 0, 1e9, false, ">= 0 [kg]");
-    if (p["com"]) pl.inertia.com = rd.vector3(p["com"], "payload.com");
-    if (p["inertia"]) {
-      const YAML::Node in = p["inertia"];
-      if (!in.IsSequence() || in.size() != 6)
-        rd.fail(in, "payload.inertia", "expected [ixx, ixy, ixz, iyy, iyz, izz] [kg m^2]");
-      double v[6];
-      for (int i = 0; i < 6; ++i)
-        v[i] = rd.number(in[i], "payload.inertia[" + std::to_string(i) + "]");
-      pl.inertia.inertia_com << v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5];
-      try {
-        validate_inertia(pl.inertia, "payload");
-      } catch (const Error& e) {
-        rd.fail(in, "payload.inertia", e.what());
-      }
-    }
-    o.payload = pl;
-  }
-
-  // solver
-  if (root["solver"]) {
-    const YAML::Node s = root["solver"];
-    rd.only_keys(s, "solver", {"max_condition", "rank_tolerance"});
-    if (s["max_condition"])
-      o.solver.max_condition =
-          rd.number_in(s["max_condition"], "solver.max_condition", 1, 1e300, true, "> 1");
-    if (s["rank_tolerance"]) {
-      o.solver.rank_tolerance =
-          rd.number_in(s["rank_tolerance"], "solver.rank_tolerance", 0, 1, true, "in (0, 1)");
-    }
-  }
+  read_sensor(rd, root["sensor"], o.sensor);
+  if (root["contact"]) read_contact(rd, root["contact"], model, o.contact);
+  if (root["observer"]) read_observer(rd, root["observer"], n, o);
+  if (root["detection"]) read_detection(rd, root["detection"], n, o.detection);
+  if (root["acceleration"]) read_acceleration(rd, root["acceleration"], o);
+  if (root["friction"]) read_friction(rd, root["friction"], n, o);
+  if (root["payload"]) read_payload(rd, root["payload"], model, o);
+  if (root["solver"]) read_solver(rd, root["solver"], o.solver);
 
   // The remaining checks need the whole picture (serial chain, sizes): build once to be sure.
   try {
@@ -328,14 +200,6 @@ EstimatorConfig interpret(const YAML::Node& root, const std::filesystem::path& s
     throw Error(rd.file() + ": " + e.what());
   }
   return cfg;
-}
-
-YAML::Node parse(const std::string& text, const std::string& name) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw Error(name + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-  }
 }
 
 std::string list(const VectorX& v) {
@@ -362,17 +226,13 @@ std::string list3(const Vector3& v) {
 
 EstimatorConfig load_estimator_config(const std::filesystem::path& path,
                                       const LoadOptions& robot_options) {
-  std::ifstream in(path);
-  if (!in) throw Error(path.string() + ": cannot open the configuration file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return interpret(parse(ss.str(), path.string()), path, robot_options);
+  return interpret(io_detail::load_yaml_file(path, "configuration"), path, robot_options);
 }
 
 EstimatorConfig load_estimator_config_string(const std::string& yaml,
                                              const std::filesystem::path& name,
                                              const LoadOptions& robot_options) {
-  return interpret(parse(yaml, name.string()), name, robot_options);
+  return interpret(io_detail::load_yaml_string(yaml, name.string()), name, robot_options);
 }
 
 std::unique_ptr<ContactEstimator> make_estimator(const EstimatorConfig& config) {

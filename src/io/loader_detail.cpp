@@ -1,7 +1,5 @@
 #include "loader_detail.hpp"
 
-#include <charconv>
-#include <cmath>
 #include <cstdlib>
 #include <system_error>
 
@@ -18,28 +16,12 @@ bool is_space(char c) {
   return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
 }
 
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
-  return s;
-}
-
 bool exists_file(const fs::path& p) {
   std::error_code ec;
   return fs::is_regular_file(p, ec);
 }
 
 }  // namespace
-
-std::optional<double> parse_double(std::string_view text) {
-  std::string_view s = trim(text);
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);  // from_chars refuses a leading '+'
-  if (s.empty() || s.front() == '+') return std::nullopt;
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc() || end != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
 
 std::vector<std::string_view> split_ws(std::string_view text) {
   std::vector<std::string_view> out;

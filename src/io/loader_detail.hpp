@@ -1,4 +1,4 @@
-// Private helpers shared by the URDF and DH-YAML loaders: strict number parsing, mesh path
+// Private helpers shared by the URDF and DH-YAML loaders: white-space splitting, mesh path
 // resolution, and turning per-link collision declarations into a GeometryModel.
 #pragma once
 
@@ -13,10 +13,6 @@
 #include "extwrench/model/model.hpp"
 
 namespace extwrench::io_detail {
-
-/// The whole text (surrounding white space allowed) as one finite double, or nothing:
-/// "abc", "1.0x", "", "nan", "inf" are all rejected (urdfdom would read "abc" as 0).
-std::optional<double> parse_double(std::string_view text);
 
 /// Splits on white space.
 std::vector<std::string_view> split_ws(std::string_view text);

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/number_text.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/model/model_builder.hpp"
 #include "loader_detail.hpp"
@@ -17,6 +18,9 @@ namespace extwrench {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Attributes are finite numbers, spaces around them allowed (urdfdom would read "abc" as 0).
+constexpr NumberRules kUrdfNumber{.trim_space = true};
 using tinyxml2::XMLElement;
 
 class UrdfParser {
@@ -89,7 +93,7 @@ class UrdfParser {
       if (fallback) return *fallback;
       fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
     }
-    const auto d = io_detail::parse_double(v);
+    const auto d = parse_number(v, kUrdfNumber);
     if (!d)
       fail(e, owner, std::string("attribute '") + attr + "': expected a number, got '" + v + "'");
     return *d;
@@ -106,7 +110,7 @@ class UrdfParser {
     Vector3 out;
     bool ok = tokens.size() == 3;
     for (std::size_t i = 0; ok && i < 3; ++i) {
-      const auto d = io_detail::parse_double(tokens[i]);
+      const auto d = parse_number(tokens[i], kUrdfNumber);
       ok = d.has_value();
       if (ok) out[static_cast<Eigen::Index>(i)] = *d;
     }

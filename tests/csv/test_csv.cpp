@@ -361,14 +361,5 @@ TEST(CsvWriter, WritesAFileTheReaderReadsBack) {
   std::filesystem::remove(path);
 }
 
-TEST(ParseNumber, AcceptsOnlyAWholeFiniteNumber) {
-  EXPECT_EQ(parse_number("1.25"), 1.25);
-  EXPECT_EQ(parse_number("+2e3"), 2000.0);
-  EXPECT_EQ(parse_number("-.5"), -0.5);
-  for (const char* bad : {"", " 1", "1 ", "abc", "1e", "nan", "inf", "0x1", "1,5", "+", "-"}) {
-    EXPECT_EQ(parse_number(bad), std::nullopt) << "'" << bad << "'";
-  }
-}
-
 }  // namespace
 }  // namespace extwrench

@@ -9,7 +9,8 @@
 //  - Cells may be quoted ("a,b", "say ""hi"""); a quoted cell cannot span lines. Spaces and
 //    tabs around a cell are trimmed.
 //  - Every row has exactly as many cells as the header.
-//  - Numbers are parsed strictly (std::from_chars, '.' decimal point, optional exponent, an
+//  - Numbers are parsed strictly (io/number_text.hpp: std::from_chars, '.' decimal point, optional
+//  exponent, an
 //    optional leading '+'); anything left over ("1.5x", "1,5", "0x10") is an error.
 //    number() also rejects empty cells, nan and inf; number_or_nan() reads an empty cell or
 //    "nan" as NaN and accepts inf / -inf.
@@ -31,10 +32,6 @@
 #include <vector>
 
 namespace extwrench {
-
-/// The whole text as one finite number with the CSV reader's strict rules (std::from_chars,
-/// optional leading '+', nothing left over), or nothing.
-[[nodiscard]] std::optional<double> parse_number(std::string_view text);
 
 class CsvReader {
  public:
@@ -141,7 +138,7 @@ class CsvWriter {
   void close();
 
   /// Shortest decimal text that reads back to the same double ("0.1", "1e-300", "inf"); NaN
-  /// gives "nan". The formatting used by add(double), for others that print numbers.
+  /// gives "nan". The formatting used by add(double): format_number (io/number_text.hpp).
   static std::string format(double value);
   /// Appends format(value) to `out` without a temporary string.
   static void append(std::string& out, double value);

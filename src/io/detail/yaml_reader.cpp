@@ -1,0 +1,213 @@
+#include "yaml_reader.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "extwrench/core/error.hpp"
+
+namespace extwrench::io_detail {
+namespace {
+
+std::string listed(std::initializer_list<const char*> names) {
+  std::string list;
+  for (const char* a : names) list += std::string(list.empty() ? "" : ", ") + a;
+  return list;
+}
+
+bool in_range(double v, const Range& r) {
+  return std::isfinite(v) && (r.lo_open ? v > r.lo : v >= r.lo) && v <= r.hi;
+}
+
+}  // namespace
+
+Range positive(const char* text) { return {0.0, std::numeric_limits<double>::max(), true, text}; }
+Range non_negative(const char* text) {
+  return {0.0, std::numeric_limits<double>::max(), false, text};
+}
+
+YAML::Node load_yaml_string(const std::string& text, const std::string& name) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw Error(name + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+  }
+}
+
+YAML::Node load_yaml_file(const std::filesystem::path& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw Error(path.string() + ": cannot open the " + what + " file");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return load_yaml_string(ss.str(), path.string());
+}
+
+YamlReader::YamlReader(std::string file, NumberRules rules)
+    : file_(std::move(file)), rules_(rules) {
+  rules_.trim_space = true;
+}
+
+std::string YamlReader::where(const YAML::Node& node) const {
+  if (!node.IsDefined() || node.Mark().line < 0) return file_;
+  return file_ + ":" + std::to_string(node.Mark().line + 1);
+}
+
+std::string YamlReader::key(const std::string& prefix, const std::string& k) {
+  return prefix.empty() ? k : prefix + "." + k;
+}
+
+std::string YamlReader::item(const std::string& key, std::size_t i) {
+  return key + "[" + std::to_string(i) + "]";
+}
+
+void YamlReader::fail(const YAML::Node& node, const std::string& key,
+                      const std::string& what) const {
+  throw Error(where(node) + ": " + key + ": " + what);
+}
+
+void YamlReader::only_keys(const YAML::Node& map, const std::string& context,
+                           std::initializer_list<const char*> allowed) const {
+  if (!map.IsMap()) fail(map, context.empty() ? "(top level)" : context, "expected a mapping");
+  const std::set<std::string> ok(allowed.begin(), allowed.end());
+  for (const auto& kv : map) {
+    const std::string k = kv.first.Scalar();
+    if (ok.count(k) == 0)
+      fail(kv.first, key(context, k), "unknown key (expected one of: " + listed(allowed) + ")");
+  }
+}
+
+YAML::Node YamlReader::required(const YAML::Node& map, const std::string& context,
+                                const char* k) const {
+  const YAML::Node n = map[k];
+  if (!n) fail(map, key(context, k), "missing (required)");
+  return n;
+}
+
+std::string YamlReader::string(const YAML::Node& node, const std::string& key) const {
+  if (!node.IsScalar() || node.Scalar().empty()) fail(node, key, "expected a non-empty string");
+  return node.Scalar();
+}
+
+std::size_t YamlReader::one_of(const YAML::Node& node, const std::string& key,
+                               std::initializer_list<const char*> names) const {
+  const std::string s = string(node, key);
+  std::size_t i = 0;
+  for (const char* name : names) {
+    if (s == name) return i;
+    ++i;
+  }
+  fail(node, key, "expected one of " + listed(names) + ", got '" + s + "'");
+}
+
+double YamlReader::parsed(const YAML::Node& node, const std::string& key, NumberRules rules) const {
+  if (!node.IsScalar()) fail(node, key, "expected a number");
+  const std::string& s = node.Scalar();
+  const auto v = parse_number(s, rules);
+  if (!v) {
+    fail(node, key,
+         std::string("expected a finite number") + (rules.pi ? " (or pi expression)" : "") +
+             ", got '" + s + "'");
+  }
+  return *v;
+}
+
+double YamlReader::number(const YAML::Node& node, const std::string& key) const {
+  return parsed(node, key, rules_);
+}
+
+double YamlReader::angle(const YAML::Node& node, const std::string& key) const {
+  NumberRules rules = rules_;
+  rules.pi = true;
+  return parsed(node, key, rules);
+}
+
+double YamlReader::number_in(const YAML::Node& node, const std::string& key,
+                             const Range& range) const {
+  const double v = number(node, key);
+  if (!in_range(v, range))
+    fail(node, key, std::string("expected a value ") + range.text + ", got " + node.Scalar());
+  return v;
+}
+
+long long YamlReader::integer(const YAML::Node& node, const std::string& key,
+                              const Range& range) const {
+  const double v = number(node, key);
+  if (!in_range(v, range) || v != std::floor(v)) {
+    fail(node, key,
+         std::string("expected a whole number ") + range.text + ", got " + node.Scalar());
+  }
+  return static_cast<long long>(v);
+}
+
+bool YamlReader::is_boolean(const YAML::Node& node) {
+  if (!node.IsScalar()) return false;
+  const std::string& s = node.Scalar();
+  return s == "true" || s == "True" || s == "yes" || s == "false" || s == "False" || s == "no";
+}
+
+bool YamlReader::boolean(const YAML::Node& node, const std::string& key) const {
+  if (!is_boolean(node)) fail(node, key, "expected true or false");
+  const std::string& s = node.Scalar();
+  return s == "true" || s == "True" || s == "yes";
+}
+
+VectorX YamlReader::vector(const YAML::Node& node, const std::string& key, int n,
+                           const Range* range) const {
+  const auto one = [&](const YAML::Node& nd, const std::string& k) {
+    return range ? number_in(nd, k, *range) : number(nd, k);
+  };
+  if (node.IsScalar()) return VectorX::Constant(n, one(node, key));
+  if (!node.IsSequence() || static_cast<int>(node.size()) != n) {
+    fail(node, key,
+         "expected " + std::to_string(n) + " values (or one for all)" +
+             (node.IsSequence() ? ", got " + std::to_string(node.size()) : ""));
+  }
+  VectorX v(n);
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    v[i] = one(node[k], item(key, k));
+  }
+  return v;
+}
+
+Vector3 YamlReader::vector3(const YAML::Node& node, const std::string& key, bool angles) const {
+  if (!node.IsSequence() || node.size() != 3) fail(node, key, "expected a list of 3 numbers");
+  Vector3 v;
+  for (std::size_t i = 0; i < 3; ++i) {
+    v[static_cast<Eigen::Index>(i)] =
+        angles ? angle(node[i], item(key, i)) : number(node[i], item(key, i));
+  }
+  return v;
+}
+
+Vector3 YamlReader::vector3_or(const YAML::Node& map, const std::string& context, const char* k,
+                               const Vector3& fallback, bool angles) const {
+  const YAML::Node n = map[k];
+  return n ? vector3(n, key(context, k), angles) : fallback;
+}
+
+Pose YamlReader::xyz_rpy(const YAML::Node& map, const std::string& context, bool angles) const {
+  return Pose::from_xyz_rpy(vector3_or(map, context, "xyz", Vector3::Zero()),
+                            vector3_or(map, context, "rpy", Vector3::Zero(), angles));
+}
+
+Pose YamlReader::pose(const YAML::Node& node, const std::string& key) const {
+  only_keys(node, key, {"xyz", "rpy"});
+  return xyz_rpy(node, key);
+}
+
+SensorType YamlReader::sensor_type(const YAML::Node& node, const std::string& key) const {
+  constexpr SensorType kTypes[] = {SensorType::kForceTorque, SensorType::kForce, SensorType::kNone};
+  return kTypes[one_of(node, key, {"ft", "force", "none"})];
+}
+
+int YamlReader::body(const Model& model, const YAML::Node& node, const std::string& key) const {
+  const std::string name = string(node, key);
+  const std::optional<int> b = model.find_body(name);
+  if (!b) fail(node, key, "no link named '" + name + "' in robot '" + model.name + "'");
+  return *b;
+}
+
+}  // namespace extwrench::io_detail
