@@ -2,130 +2,41 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <cerrno>
-#include <cmath>
-#include <cstdlib>
-#include <fstream>
-#include <limits>
-#include <set>
+#include <string>
 
+#include "detail/yaml_reader.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/csv.hpp"
 
 namespace extwrench {
 namespace {
 
-class Yaml {
- public:
-  explicit Yaml(std::string file) : file_(std::move(file)) {}
+namespace fs = std::filesystem;
+using io_detail::non_negative;
+using io_detail::positive;
+using io_detail::Range;
+using io_detail::YamlReader;
 
-  [[noreturn]] void fail(const YAML::Node& node, const std::string& key,
-                         const std::string& what) const {
-    std::string where = file_;
-    if (node.IsDefined() && node.Mark().line >= 0)
-      where += ":" + std::to_string(node.Mark().line + 1);
-    throw Error(where + ": " + key + ": " + what);
-  }
+// Scenario numbers may be inf ("end: inf", a force that never stops).
+constexpr NumberRules kScenarioNumber{.infinity = true};
 
-  void only_keys(const YAML::Node& map, const std::string& prefix,
-                 std::initializer_list<const char*> allowed) const {
-    if (!map.IsMap()) fail(map, prefix.empty() ? "(top level)" : prefix, "expected a mapping");
-    const std::set<std::string> ok(allowed.begin(), allowed.end());
-    for (const auto& kv : map) {
-      const std::string k = kv.first.Scalar();
-      if (ok.count(k) == 0) {
-        std::string list;
-        for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-        fail(kv.first, key(prefix, k), "unknown key (expected one of: " + list + ")");
-      }
-    }
-  }
-
-  static std::string key(const std::string& prefix, const std::string& k) {
-    return prefix.empty() ? k : prefix + "." + k;
-  }
-
-  double number(const YAML::Node& node, const std::string& k) const {
-    if (!node.IsScalar()) fail(node, k, "expected a number");
-    const std::string& s = node.Scalar();
-    if (s == ".inf" || s == "inf") return std::numeric_limits<double>::infinity();
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(s.c_str(), &end);
-    if (s.empty() || end != s.c_str() + s.size() || errno == ERANGE || !std::isfinite(v)) {
-      fail(node, k, "expected a finite number, got '" + s + "'");
-    }
-    return v;
-  }
-
-  double positive(const YAML::Node& node, const std::string& k) const {
-    const double v = number(node, k);
-    if (!(v > 0.0) || !std::isfinite(v))
-      fail(node, k, "expected a positive number, got " + node.Scalar());
-    return v;
-  }
-
-  double non_negative(const YAML::Node& node, const std::string& k) const {
-    const double v = number(node, k);
-    if (!(v >= 0.0) || !std::isfinite(v))
-      fail(node, k, "expected a number >= 0, got " + node.Scalar());
-    return v;
-  }
-
-  bool boolean(const YAML::Node& node, const std::string& k) const {
-    if (node.IsScalar()) {
-      const std::string& s = node.Scalar();
-      if (s == "true" || s == "yes") return true;
-      if (s == "false" || s == "no") return false;
-    }
-    fail(node, k, "expected true or false");
-  }
-
-  std::string string(const YAML::Node& node, const std::string& k) const {
-    if (!node.IsScalar() || node.Scalar().empty()) fail(node, k, "expected a non-empty string");
-    return node.Scalar();
-  }
-
-  /// A list of n numbers, or one number for all n.
-  VectorX vector(const YAML::Node& node, const std::string& k, int n) const {
-    if (node.IsScalar()) return VectorX::Constant(n, number(node, k));
-    if (!node.IsSequence() || static_cast<int>(node.size()) != n) {
-      fail(node, k,
-           "expected " + std::to_string(n) + " numbers (or one for all)" +
-               (node.IsSequence() ? ", got " + std::to_string(node.size()) : ""));
-    }
-    VectorX v(n);
-    for (int i = 0; i < n; ++i)
-      v[i] = number(node[static_cast<std::size_t>(i)], k + "[" + std::to_string(i) + "]");
-    return v;
-  }
-
-  Vector3 vector3(const YAML::Node& node, const std::string& k) const {
-    if (!node.IsSequence() || node.size() != 3) fail(node, k, "expected 3 numbers [x, y, z]");
-    return vector(node, k, 3);
-  }
-
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-};
-
-void parse_trajectory(const Yaml& y, const YAML::Node& node, int n, sim::SinusoidalTrajectory& tr) {
+void parse_trajectory(const YamlReader& y, const YAML::Node& node, int n,
+                      sim::SinusoidalTrajectory& tr) {
   y.only_keys(node, "trajectory", {"offset", "amplitude", "frequency", "phase"});
-  tr.offset = node["offset"] ? y.vector(node["offset"], "trajectory.offset", n) : VectorX::Zero(n);
-  tr.amplitude =
-      node["amplitude"] ? y.vector(node["amplitude"], "trajectory.amplitude", n) : VectorX::Zero(n);
-  tr.frequency =
-      node["frequency"] ? y.vector(node["frequency"], "trajectory.frequency", n) : VectorX::Zero(n);
-  tr.phase = node["phase"] ? y.vector(node["phase"], "trajectory.phase", n) : VectorX::Zero(n);
+  const auto part = [&](const char* k) {
+    return node[k] ? y.vector(node[k], YamlReader::key("trajectory", k), n) : VectorX::Zero(n);
+  };
+  tr.offset = part("offset");
+  tr.amplitude = part("amplitude");
+  tr.frequency = part("frequency");
+  tr.phase = part("phase");
   for (int i = 0; i < n; ++i) {
     if (tr.frequency[i] < 0.0)
       y.fail(node["frequency"], "trajectory.frequency", "frequencies must be >= 0 [Hz]");
   }
 }
 
-sim::ForceProfile parse_force(const Yaml& y, const YAML::Node& node, const std::string& k,
+sim::ForceProfile parse_force(const YamlReader& y, const YAML::Node& node, const std::string& k,
                               const Model& model) {
   y.only_keys(node, k,
               {"frame", "link", "axes", "force", "moment", "point", "start", "end", "ramp"});
@@ -139,231 +50,196 @@ sim::ForceProfile parse_force(const Yaml& y, const YAML::Node& node, const std::
     y.fail(fr, k + ".frame", "'" + f.frame + "' is not a frame of robot '" + model.name + "'");
   }
   if (node["axes"]) {
-    const std::string a = y.string(node["axes"], k + ".axes");
-    if (a == "frame" || a == "link") {
-      f.axes = sim::ForceProfile::Axes::kFrame;
-    } else if (a == "world") {
-      f.axes = sim::ForceProfile::Axes::kWorld;
-    } else {
-      y.fail(node["axes"], k + ".axes", "expected 'frame' or 'world', got '" + a + "'");
-    }
+    f.axes = y.one_of(node["axes"], k + ".axes", {"frame", "link", "world"}) == 2
+                 ? sim::ForceProfile::Axes::kWorld
+                 : sim::ForceProfile::Axes::kFrame;
   }
   if (node["force"]) f.force = y.vector3(node["force"], k + ".force");
   if (node["moment"]) f.moment = y.vector3(node["moment"], k + ".moment");
   if (node["point"]) f.point = y.vector3(node["point"], k + ".point");
   if (node["start"]) f.start = y.number(node["start"], k + ".start");
   if (node["end"]) f.end = y.number(node["end"], k + ".end");
-  if (node["ramp"]) f.ramp = y.non_negative(node["ramp"], k + ".ramp");
+  if (node["ramp"]) f.ramp = y.number_in(node["ramp"], k + ".ramp", non_negative());
   if (!(f.end > f.start)) y.fail(node, k, "end must be after start");
   return f;
 }
 
-void parse_sensors(const Yaml& y, const YAML::Node& node, Scenario& s) {
+// The simulated base sensor; its pose defaults to the robot's frame 'sensor' on link 0.
+void parse_base_sensor(const YamlReader& y, const YAML::Node& b, sim::BaseSensorModel& base) {
+  y.only_keys(b, "sensors.base", {"type", "pose", "bias", "force_noise", "moment_noise"});
+  if (b["type"]) {
+    // (until sim uses SensorType itself)
+    switch (y.sensor_type(b["type"], "sensors.base.type")) {
+      case SensorType::kForceTorque:
+        base.type = sim::BaseSensorType::kForceTorque;
+        break;
+      case SensorType::kForce:
+        base.type = sim::BaseSensorType::kForce;
+        break;
+      case SensorType::kNone:
+        base.type = sim::BaseSensorType::kNone;
+        break;
+    }
+  }
+  if (b["pose"]) base.X_RS = y.pose(b["pose"], "sensors.base.pose");
+  if (b["bias"]) base.bias = y.vector(b["bias"], "sensors.base.bias", 6);
+  if (b["force_noise"])
+    base.force_noise = y.vector(b["force_noise"], "sensors.base.force_noise", 3);
+  if (b["moment_noise"])
+    base.moment_noise = y.vector(b["moment_noise"], "sensors.base.moment_noise", 3);
+  if ((base.force_noise.array() < 0).any() || (base.moment_noise.array() < 0).any()) {
+    y.fail(b, "sensors.base", "noise standard deviations must be >= 0");
+  }
+}
+
+void parse_encoder(const YamlReader& y, const YAML::Node& e, sim::EncoderModel& encoder) {
+  y.only_keys(e, "sensors.encoder", {"resolution", "velocity", "velocity_cutoff"});
+  if (e["resolution"])
+    encoder.resolution = y.number_in(e["resolution"], "sensors.encoder.resolution", non_negative());
+  if (e["velocity"]) {
+    encoder.differentiate =
+        y.one_of(e["velocity"], "sensors.encoder.velocity", {"exact", "differentiate"}) == 1;
+  }
+  if (e["velocity_cutoff"]) {
+    encoder.velocity_cutoff =
+        y.number_in(e["velocity_cutoff"], "sensors.encoder.velocity_cutoff", non_negative());
+  }
+}
+
+void parse_sensors(const YamlReader& y, const YAML::Node& node, Scenario& s) {
   y.only_keys(node, "sensors", {"base", "encoder", "log_velocity"});
   sim::BaseSensorModel& base = s.simulation.sensor;
   base.type = sim::BaseSensorType::kForceTorque;
-  std::string ignored;
   base.X_RS = Pose::identity();
   if (const auto sf = s.robot.model.find_frame("sensor")) {
     const Frame& f = s.robot.model.frames[static_cast<std::size_t>(*sf)];
     if (f.body == 0) base.X_RS = f.placement;
   }
-  if (const YAML::Node b = node["base"]) {
-    y.only_keys(b, "sensors.base", {"type", "pose", "bias", "force_noise", "moment_noise"});
-    if (b["type"]) {
-      const std::string t = y.string(b["type"], "sensors.base.type");
-      if (t == "ft") {
-        base.type = sim::BaseSensorType::kForceTorque;
-      } else if (t == "force") {
-        base.type = sim::BaseSensorType::kForce;
-      } else if (t == "none") {
-        base.type = sim::BaseSensorType::kNone;
-      } else {
-        y.fail(b["type"], "sensors.base.type", "expected ft, force or none, got '" + t + "'");
-      }
-    }
-    if (const YAML::Node p = b["pose"]) {
-      y.only_keys(p, "sensors.base.pose", {"xyz", "rpy"});
-      const Vector3 xyz = p["xyz"] ? y.vector3(p["xyz"], "sensors.base.pose.xyz") : Vector3::Zero();
-      const Vector3 rpy = p["rpy"] ? y.vector3(p["rpy"], "sensors.base.pose.rpy") : Vector3::Zero();
-      base.X_RS = Pose::from_xyz_rpy(xyz, rpy);
-    }
-    if (b["bias"]) base.bias = y.vector(b["bias"], "sensors.base.bias", 6);
-    if (b["force_noise"])
-      base.force_noise = y.vector(b["force_noise"], "sensors.base.force_noise", 3);
-    if (b["moment_noise"])
-      base.moment_noise = y.vector(b["moment_noise"], "sensors.base.moment_noise", 3);
-    if ((base.force_noise.array() < 0).any() || (base.moment_noise.array() < 0).any()) {
-      y.fail(b, "sensors.base", "noise standard deviations must be >= 0");
-    }
-  }
-  if (const YAML::Node e = node["encoder"]) {
-    y.only_keys(e, "sensors.encoder", {"resolution", "velocity", "velocity_cutoff"});
-    if (e["resolution"])
-      s.simulation.encoder.resolution =
-          y.non_negative(e["resolution"], "sensors.encoder.resolution");
-    if (e["velocity"]) {
-      const std::string v = y.string(e["velocity"], "sensors.encoder.velocity");
-      if (v == "exact") {
-        s.simulation.encoder.differentiate = false;
-      } else if (v == "differentiate") {
-        s.simulation.encoder.differentiate = true;
-      } else {
-        y.fail(e["velocity"], "sensors.encoder.velocity",
-               "expected exact or differentiate, got '" + v + "'");
-      }
-    }
-    if (e["velocity_cutoff"]) {
-      s.simulation.encoder.velocity_cutoff =
-          y.non_negative(e["velocity_cutoff"], "sensors.encoder.velocity_cutoff");
-    }
-  }
+  if (const YAML::Node b = node["base"]) parse_base_sensor(y, b, base);
+  if (const YAML::Node e = node["encoder"]) parse_encoder(y, e, s.simulation.encoder);
   if (node["log_velocity"])
     s.log_velocity = y.boolean(node["log_velocity"], "sensors.log_velocity");
 }
 
-void parse_metrics(const Yaml& y, const YAML::Node& node, Scenario& s) {
+void parse_metrics(const YamlReader& y, const YAML::Node& node, Scenario& s) {
   y.only_keys(
       node, "metrics",
       {"from", "exclude", "exclude_around_singularity", "singularity_link", "surface_point"});
-  if (node["from"]) s.metrics_from = y.non_negative(node["from"], "metrics.from");
+  if (node["from"]) s.metrics_from = y.number_in(node["from"], "metrics.from", non_negative());
   if (const YAML::Node ex = node["exclude"]) {
     if (!ex.IsSequence()) y.fail(ex, "metrics.exclude", "expected a list of [from, to] intervals");
     for (std::size_t i = 0; i < ex.size(); ++i) {
-      const std::string k = "metrics.exclude[" + std::to_string(i) + "]";
+      const std::string k = YamlReader::item("metrics.exclude", i);
       const VectorX v = y.vector(ex[i], k, 2);
       if (!(v[0] < v[1])) y.fail(ex[i], k, "expected [from, to] with from < to");
       s.metrics_exclude.emplace_back(v[0], v[1]);
     }
   }
   if (node["exclude_around_singularity"]) {
-    s.singularity_half_width =
-        y.non_negative(node["exclude_around_singularity"], "metrics.exclude_around_singularity");
+    s.singularity_half_width = y.number_in(node["exclude_around_singularity"],
+                                           "metrics.exclude_around_singularity", non_negative());
   }
   if (node["singularity_link"]) {
     s.singularity_link = y.string(node["singularity_link"], "metrics.singularity_link");
-    if (!s.robot.model.find_body(s.singularity_link)) {
-      y.fail(node["singularity_link"], "metrics.singularity_link",
-             "'" + s.singularity_link + "' is not a link of the robot");
-    }
+    (void)y.body(s.robot.model, node["singularity_link"], "metrics.singularity_link");
   }
   if (node["surface_point"])
     s.surface_metrics = y.boolean(node["surface_point"], "metrics.surface_point");
 }
 
-}  // namespace
-
-Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& robot_options) {
-  const std::string file = path.string();
-  Yaml y(file);
-  YAML::Node root;
-  {
-    std::ifstream in(path);
-    if (!in) throw Error(file + ": cannot open the scenario file");
-    try {
-      root = YAML::Load(in);
-    } catch (const YAML::Exception& e) {
-      throw Error(file + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-    }
-  }
-  if (!root.IsDefined() || root.IsNull()) throw Error(file + ": the scenario is empty");
-  y.only_keys(root, "",
-              {"robot", "seed", "seeds", "duration", "sample_time", "substeps", "model_error",
-               "trajectory", "controller", "forces", "sensors", "metrics", "figures", "schemes"});
-  Scenario s;
-  s.source = path;
+// The robot file, relative to the scenario.
+void parse_robot(const YamlReader& y, const YAML::Node& root, const LoadOptions& robot_options,
+                 Scenario& s) {
   if (!root["robot"])
     y.fail(root, "robot", "missing (the robot file, URDF or DH YAML, relative to the scenario)");
-  const std::filesystem::path robot = y.string(root["robot"], "robot");
-  s.robot_path = robot.is_absolute() ? robot : path.parent_path() / robot;
+  const fs::path robot = y.string(root["robot"], "robot");
+  s.robot_path = robot.is_absolute() ? robot : s.source.parent_path() / robot;
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(s.robot_path, ec)) {
+  if (!fs::is_regular_file(s.robot_path, ec))
     y.fail(root["robot"], "robot", "no such file '" + s.robot_path.string() + "'");
-  }
   s.robot = load_robot(s.robot_path, robot_options);
-  const Model& model = s.robot.model;
-  const int n = model.nq();
+}
 
+// seed: 3 or seeds: [1, 2, 3].
+void parse_seeds(const YamlReader& y, const YAML::Node& root, Scenario& s) {
   if (root["seed"] && root["seeds"])
     y.fail(root["seeds"], "seeds", "give either seed or seeds, not both");
-  if (const YAML::Node sd = root["seed"] ? root["seed"] : root["seeds"]) {
-    const std::string k = root["seed"] ? "seed" : "seeds";
-    s.seeds.clear();
-    auto one = [&](const YAML::Node& v, const std::string& kk) {
-      const double x = y.non_negative(v, kk);
-      if (x != std::floor(x) || x > 9.0e15) y.fail(v, kk, "expected a non-negative integer");
-      s.seeds.push_back(static_cast<std::uint64_t>(x));
-    };
-    if (sd.IsSequence()) {
-      if (sd.size() == 0) y.fail(sd, k, "expected at least one seed");
-      for (std::size_t i = 0; i < sd.size(); ++i) one(sd[i], k + "[" + std::to_string(i) + "]");
-    } else {
-      one(sd, k);
-    }
+  const YAML::Node sd = root["seed"] ? root["seed"] : root["seeds"];
+  if (!sd) return;
+  const std::string k = root["seed"] ? "seed" : "seeds";
+  const Range seed{0.0, 9.0e15, false, ">= 0"};
+  s.seeds.clear();
+  if (!sd.IsSequence()) {
+    s.seeds.push_back(static_cast<std::uint64_t>(y.integer(sd, k, seed)));
+    return;
   }
-  if (root["duration"]) s.simulation.duration = y.positive(root["duration"], "duration");
+  if (sd.size() == 0) y.fail(sd, k, "expected at least one seed");
+  for (std::size_t i = 0; i < sd.size(); ++i)
+    s.seeds.push_back(static_cast<std::uint64_t>(y.integer(sd[i], YamlReader::item(k, i), seed)));
+}
+
+// duration, sample_time, substeps and model_error.
+void parse_timing(const YamlReader& y, const YAML::Node& root, Scenario& s) {
+  sim::SimulationConfig& sc = s.simulation;
+  if (root["duration"]) sc.duration = y.number_in(root["duration"], "duration", positive());
   if (root["sample_time"])
-    s.simulation.sample_time = y.positive(root["sample_time"], "sample_time");
+    sc.sample_time = y.number_in(root["sample_time"], "sample_time", positive());
   if (root["substeps"]) {
-    const double v = y.positive(root["substeps"], "substeps");
-    if (v != std::floor(v) || v > 1000)
-      y.fail(root["substeps"], "substeps", "expected an integer in [1, 1000]");
-    s.simulation.substeps = static_cast<int>(v);
+    sc.substeps =
+        static_cast<int>(y.integer(root["substeps"], "substeps", {1, 1000, false, "in [1, 1000]"}));
   }
-  if (s.simulation.duration / s.simulation.sample_time > 1e8) {
+  if (sc.duration / sc.sample_time > 1e8) {
     y.fail(root["duration"], "duration",
            "more than 1e8 samples: reduce duration or increase sample_time");
   }
   if (root["model_error"]) {
-    s.model_error = y.non_negative(root["model_error"], "model_error");
+    s.model_error = y.number_in(root["model_error"], "model_error", non_negative());
     if (s.model_error >= 0.5)
       y.fail(root["model_error"], "model_error",
              "expected a fraction in [0, 0.5), e.g. 0.01 for ±1 %");
   }
-  if (!root["trajectory"])
-    y.fail(root, "trajectory", "missing (offset, amplitude, frequency, phase per joint)");
-  parse_trajectory(y, root["trajectory"], n, s.trajectory);
+}
 
+// omega (triple pole, the default 10 rad/s) or kp, kd, ki per joint.
+void parse_controller(const YamlReader& y, const YAML::Node& root, int n, Scenario& s) {
   s.gains = sim::pid_gains_triple_pole(n, 10.0);
   s.controller_omega = 10.0;
-  if (const YAML::Node c = root["controller"]) {
-    y.only_keys(c, "controller", {"omega", "kp", "kd", "ki"});
-    if (c["omega"] && (c["kp"] || c["kd"] || c["ki"]))
-      y.fail(c, "controller", "give omega or kp/kd/ki, not both");
-    if (c["omega"]) {
-      s.controller_omega = y.positive(c["omega"], "controller.omega");
-      s.gains = sim::pid_gains_triple_pole(n, s.controller_omega);
-    } else {
-      s.controller_omega = 0.0;
-      if (c["kp"]) s.gains.kp = y.vector(c["kp"], "controller.kp", n);
-      if (c["kd"]) s.gains.kd = y.vector(c["kd"], "controller.kd", n);
-      if (c["ki"]) s.gains.ki = y.vector(c["ki"], "controller.ki", n);
-      for (const auto* g : {&s.gains.kp, &s.gains.kd, &s.gains.ki}) {
-        if ((g->array() < 0).any()) y.fail(c, "controller", "gains must be >= 0");
-      }
-    }
+  const YAML::Node c = root["controller"];
+  if (!c) return;
+  y.only_keys(c, "controller", {"omega", "kp", "kd", "ki"});
+  if (c["omega"] && (c["kp"] || c["kd"] || c["ki"]))
+    y.fail(c, "controller", "give omega or kp/kd/ki, not both");
+  if (c["omega"]) {
+    s.controller_omega = y.number_in(c["omega"], "controller.omega", positive());
+    s.gains = sim::pid_gains_triple_pole(n, s.controller_omega);
+    return;
   }
-  if (const YAML::Node f = root["forces"]) {
-    if (!f.IsSequence()) y.fail(f, "forces", "expected a list of forces");
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      s.simulation.forces.push_back(
-          parse_force(y, f[i], "forces[" + std::to_string(i) + "]", model));
-    }
+  s.controller_omega = 0.0;
+  if (c["kp"]) s.gains.kp = y.vector(c["kp"], "controller.kp", n);
+  if (c["kd"]) s.gains.kd = y.vector(c["kd"], "controller.kd", n);
+  if (c["ki"]) s.gains.ki = y.vector(c["ki"], "controller.ki", n);
+  for (const auto* g : {&s.gains.kp, &s.gains.kd, &s.gains.ki}) {
+    if ((g->array() < 0).any()) y.fail(c, "controller", "gains must be >= 0");
   }
-  parse_sensors(y, root["sensors"] ? root["sensors"] : YAML::Node(YAML::NodeType::Map), s);
-  if (root["metrics"]) parse_metrics(y, root["metrics"], s);
-  if (s.singularity_half_width > 0.0 && s.singularity_link.empty()) {
-    if (s.simulation.forces.empty()) {
-      y.fail(root["metrics"], "metrics.exclude_around_singularity",
-             "needs metrics.singularity_link (there is no force)");
-    }
-    const int body =
-        model.frames[static_cast<std::size_t>(*model.find_frame(s.simulation.forces.front().frame))]
-            .body;
-    s.singularity_link = model.bodies[static_cast<std::size_t>(body)].name;
-  }
-  if (root["figures"]) s.figures = y.boolean(root["figures"], "figures");
+}
 
+// Without singularity_link, the singularity window follows the first force's body.
+void default_singularity_link(const YamlReader& y, const YAML::Node& root, Scenario& s) {
+  if (!(s.singularity_half_width > 0.0) || !s.singularity_link.empty()) return;
+  if (s.simulation.forces.empty()) {
+    y.fail(root["metrics"], "metrics.exclude_around_singularity",
+           "needs metrics.singularity_link (there is no force)");
+  }
+  const Model& model = s.robot.model;
+  const int body =
+      model.frames[static_cast<std::size_t>(*model.find_frame(s.simulation.forces.front().frame))]
+          .body;
+  s.singularity_link = model.bodies[static_cast<std::size_t>(body)].name;
+}
+
+// Each scheme is an estimator configuration without `robot`, kept as YAML text: it is checked
+// in full when run_scenario writes and reads it back.
+void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
   const YAML::Node schemes = root["schemes"];
   if (!schemes) y.fail(root, "schemes", "missing (one or more estimator configurations, by name)");
   if (!schemes.IsMap() || schemes.size() == 0)
@@ -386,6 +262,38 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& rob
     out << kv.second;
     s.schemes.push_back({name, out.c_str(), kv.second.Mark().line + 1});
   }
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& robot_options) {
+  const YamlReader y(path.string(), kScenarioNumber);
+  const YAML::Node root = io_detail::load_yaml_file(path, "scenario");
+  if (!root.IsDefined() || root.IsNull()) throw Error(y.file() + ": the scenario is empty");
+  y.only_keys(root, "",
+              {"robot", "seed", "seeds", "duration", "sample_time", "substeps", "model_error",
+               "trajectory", "controller", "forces", "sensors", "metrics", "figures", "schemes"});
+  Scenario s;
+  s.source = path;
+  parse_robot(y, root, robot_options, s);
+  const Model& model = s.robot.model;
+  const int n = model.nq();
+  parse_seeds(y, root, s);
+  parse_timing(y, root, s);
+  if (!root["trajectory"])
+    y.fail(root, "trajectory", "missing (offset, amplitude, frequency, phase per joint)");
+  parse_trajectory(y, root["trajectory"], n, s.trajectory);
+  parse_controller(y, root, n, s);
+  if (const YAML::Node f = root["forces"]) {
+    if (!f.IsSequence()) y.fail(f, "forces", "expected a list of forces");
+    for (std::size_t i = 0; i < f.size(); ++i)
+      s.simulation.forces.push_back(parse_force(y, f[i], YamlReader::item("forces", i), model));
+  }
+  parse_sensors(y, root["sensors"] ? root["sensors"] : YAML::Node(YAML::NodeType::Map), s);
+  if (root["metrics"]) parse_metrics(y, root["metrics"], s);
+  default_singularity_link(y, root, s);
+  if (root["figures"]) s.figures = y.boolean(root["figures"], "figures");
+  parse_schemes(y, root, s);
   return s;
 }
 
