@@ -63,15 +63,9 @@ void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionO
   rd.only_keys(d, "detection", {"tau_min", "f_min", "release_ratio", "min_duration"});
   const Range tau_min = positive();
   if (d["tau_min"]) o.tau_min = rd.vector(d["tau_min"], "detection.tau_min", n, &tau_min);
-  if (d["f_min"]) o.f_min = rd.number_in(d["f_min"], "detection.f_min", {0, 1e12, true, "> 0 [N]"});
-  if (d["release_ratio"]) {
-    o.release_ratio =
-        rd.number_in(d["release_ratio"], "detection.release_ratio", {0, 1, true, "in (0, 1]"});
-  }
-  if (d["min_duration"]) {
-    o.min_duration =
-        rd.number_in(d["min_duration"], "detection.min_duration", {0, 1e6, false, ">= 0 [s]"});
-  }
+  rd.set_number_in(d, "detection", "f_min", {0, 1e12, true, "> 0 [N]"}, o.f_min);
+  rd.set_number_in(d, "detection", "release_ratio", {0, 1, true, "in (0, 1]"}, o.release_ratio);
+  rd.set_number_in(d, "detection", "min_duration", {0, 1e6, false, ">= 0 [s]"}, o.min_duration);
 }
 
 // Either a route (acceleration: residual) or a mapping {route, cutoff}.
@@ -79,10 +73,8 @@ void read_acceleration(const YamlReader& rd, const YAML::Node& a, EstimatorOptio
   if (a.IsMap()) {
     rd.only_keys(a, "acceleration", {"route", "cutoff"});
     if (!a["route"]) rd.fail(a, "acceleration.route", "missing (residual | differentiation)");
-    if (a["cutoff"]) {
-      o.differentiation_cutoff =
-          rd.number_in(a["cutoff"], "acceleration.cutoff", {0, 1e9, true, "> 0 [Hz]"});
-    }
+    rd.set_number_in(a, "acceleration", "cutoff", {0, 1e9, true, "> 0 [Hz]"},
+                     o.differentiation_cutoff);
   }
   // (a fresh handle: assigning to a YAML::Node would overwrite the node it refers to)
   const YAML::Node route = a.IsMap() ? a["route"] : a;
@@ -109,10 +101,8 @@ void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOp
   const Range coefficient = non_negative();
   if (f["viscous"]) jf.viscous = rd.vector(f["viscous"], "friction.viscous", n, &coefficient);
   if (f["coulomb"]) jf.coulomb = rd.vector(f["coulomb"], "friction.coulomb", n, &coefficient);
-  if (f["smoothing_velocity"]) {
-    jf.smoothing_velocity =
-        rd.number_in(f["smoothing_velocity"], "friction.smoothing_velocity", {0, 1e9, true, "> 0"});
-  }
+  rd.set_number_in(f, "friction", "smoothing_velocity", {0, 1e9, true, "> 0"},
+                   jf.smoothing_velocity);
   o.friction = jf;
 }
 
@@ -143,14 +133,8 @@ void read_payload(const YamlReader& rd, const YAML::Node& p, const Model& model,
 
 void read_solver(const YamlReader& rd, const YAML::Node& s, SolverOptions& o) {
   rd.only_keys(s, "solver", {"max_condition", "rank_tolerance"});
-  if (s["max_condition"]) {
-    o.max_condition =
-        rd.number_in(s["max_condition"], "solver.max_condition", {1, 1e300, true, "> 1"});
-  }
-  if (s["rank_tolerance"]) {
-    o.rank_tolerance =
-        rd.number_in(s["rank_tolerance"], "solver.rank_tolerance", {0, 1, true, "in (0, 1)"});
-  }
+  rd.set_number_in(s, "solver", "max_condition", {1, 1e300, true, "> 1"}, o.max_condition);
+  rd.set_number_in(s, "solver", "rank_tolerance", {0, 1, true, "in (0, 1)"}, o.rank_tolerance);
 }
 
 // The robot file, relative to the configuration, loaded with the configuration's gravity.

@@ -94,16 +94,12 @@ void parse_base_sensor(const YamlReader& y, const YAML::Node& b, sim::BaseSensor
 
 void parse_encoder(const YamlReader& y, const YAML::Node& e, sim::EncoderModel& encoder) {
   y.only_keys(e, "sensors.encoder", {"resolution", "velocity", "velocity_cutoff"});
-  if (e["resolution"])
-    encoder.resolution = y.number_in(e["resolution"], "sensors.encoder.resolution", non_negative());
+  y.set_number_in(e, "sensors.encoder", "resolution", non_negative(), encoder.resolution);
   if (e["velocity"]) {
     encoder.differentiate =
         y.one_of(e["velocity"], "sensors.encoder.velocity", {"exact", "differentiate"}) == 1;
   }
-  if (e["velocity_cutoff"]) {
-    encoder.velocity_cutoff =
-        y.number_in(e["velocity_cutoff"], "sensors.encoder.velocity_cutoff", non_negative());
-  }
+  y.set_number_in(e, "sensors.encoder", "velocity_cutoff", non_negative(), encoder.velocity_cutoff);
 }
 
 void parse_sensors(const YamlReader& y, const YAML::Node& node, Scenario& s) {
@@ -125,7 +121,7 @@ void parse_metrics(const YamlReader& y, const YAML::Node& node, Scenario& s) {
   y.only_keys(
       node, "metrics",
       {"from", "exclude", "exclude_around_singularity", "singularity_link", "surface_point"});
-  if (node["from"]) s.metrics_from = y.number_in(node["from"], "metrics.from", non_negative());
+  y.set_number_in(node, "metrics", "from", non_negative(), s.metrics_from);
   if (const YAML::Node ex = node["exclude"]) {
     if (!ex.IsSequence()) y.fail(ex, "metrics.exclude", "expected a list of [from, to] intervals");
     for (std::size_t i = 0; i < ex.size(); ++i) {
@@ -135,10 +131,8 @@ void parse_metrics(const YamlReader& y, const YAML::Node& node, Scenario& s) {
       s.metrics_exclude.emplace_back(v[0], v[1]);
     }
   }
-  if (node["exclude_around_singularity"]) {
-    s.singularity_half_width = y.number_in(node["exclude_around_singularity"],
-                                           "metrics.exclude_around_singularity", non_negative());
-  }
+  y.set_number_in(node, "metrics", "exclude_around_singularity", non_negative(),
+                  s.singularity_half_width);
   if (node["singularity_link"]) {
     s.singularity_link = y.string(node["singularity_link"], "metrics.singularity_link");
     (void)y.body(s.robot.model, node["singularity_link"], "metrics.singularity_link");
@@ -181,9 +175,8 @@ void parse_seeds(const YamlReader& y, const YAML::Node& root, Scenario& s) {
 // duration, sample_time, substeps and model_error.
 void parse_timing(const YamlReader& y, const YAML::Node& root, Scenario& s) {
   sim::SimulationConfig& sc = s.simulation;
-  if (root["duration"]) sc.duration = y.number_in(root["duration"], "duration", positive());
-  if (root["sample_time"])
-    sc.sample_time = y.number_in(root["sample_time"], "sample_time", positive());
+  y.set_number_in(root, "", "duration", positive(), sc.duration);
+  y.set_number_in(root, "", "sample_time", positive(), sc.sample_time);
   if (root["substeps"]) {
     sc.substeps =
         static_cast<int>(y.integer(root["substeps"], "substeps", {1, 1000, false, "in [1, 1000]"}));

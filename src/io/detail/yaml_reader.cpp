@@ -131,6 +131,11 @@ double YamlReader::number_in(const YAML::Node& node, const std::string& key,
   return v;
 }
 
+void YamlReader::set_number_in(const YAML::Node& map, const std::string& context, const char* k,
+                               const Range& range, double& out) const {
+  if (const YAML::Node n = map[k]) out = number_in(n, key(context, k), range);
+}
+
 long long YamlReader::integer(const YAML::Node& node, const std::string& key,
                               const Range& range) const {
   const double v = number(node, key);

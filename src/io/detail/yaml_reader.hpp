@@ -72,6 +72,9 @@ class YamlReader {
   /// A finite number in `range`.
   [[nodiscard]] double number_in(const YAML::Node& node, const std::string& key,
                                  const Range& range) const;
+  /// Sets `out` to map[k] as number_in(range) when the key is there.
+  void set_number_in(const YAML::Node& map, const std::string& context, const char* k,
+                     const Range& range, double& out) const;
   /// A whole number in `range` (written as a number: "3", "3.0", "1e3").
   [[nodiscard]] long long integer(const YAML::Node& node, const std::string& key,
                                   const Range& range) const;
