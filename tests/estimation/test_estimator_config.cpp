@@ -162,6 +162,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"sensor: {type: ft}\ndetection:\n  min_duration: -0.1\n",
                   ":4:", "detection.min_duration", ">= 0"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: 0\n", ":4:", "detection.f_min", "> 0"},
+        BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: inf\n", ":4:", "detection.f_min",
+                  "expected a finite number, got 'inf'"},
         BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n  link: link99\n",
                   ":5:", "contact.link", "no link named 'link99'"},
         BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n", ":4:", "contact.link",

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 
 #include "extwrench/app/scenario_run.hpp"
@@ -320,6 +321,22 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
     EXPECT_NE(what.find(c.expected), std::string::npos) << c.name << ": " << what;
     EXPECT_NE(what.find(path.filename().string()), std::string::npos) << c.name << ": " << what;
   }
+}
+
+TEST_F(Replay, ScenarioNumbersMayBeInfiniteWhereAFiniteValueIsNotRequired) {
+  const fs::path dir = temp_dir("infscenario");
+  for (const char* inf : {"inf", ".inf"}) {
+    write_file(dir / "s.yaml",
+               replace(kGoodScenario, "start: 0.1", std::string("start: 0.1, end: ") + inf));
+    const Scenario s = load_scenario(dir / "s.yaml");
+    ASSERT_EQ(s.simulation.forces.size(), 1U);
+    EXPECT_EQ(s.simulation.forces[0].end, std::numeric_limits<double>::infinity()) << inf;
+  }
+  write_file(dir / "s.yaml", replace(kGoodScenario, "duration: 0.5", "duration: inf"));
+  EXPECT_NE(error_of([&] {
+              (void)load_scenario(dir / "s.yaml");
+            }).find("duration: expected a value > 0, got inf"),
+            std::string::npos);
 }
 
 TEST_F(Replay, SchemeWithABadEstimatorKeyFailsBeforeSimulatingAndNamesTheScheme) {
