@@ -7,7 +7,6 @@
 #include "commands.hpp"
 #include "extwrench/app/replay.hpp"
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/csv.hpp"
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/number_text.hpp"
 
@@ -39,7 +38,7 @@ std::pair<double, double> parse_interval(const std::string& text) {
 
 void run_estimate(const EstimateOptions& opt) {
   sim::MetricsWindow window{opt.metrics_from, opt.metrics_to, {}};
-  std::string description = "from t = " + CsvWriter::format(opt.metrics_from) + " s";
+  std::string description = "from t = " + format_number(opt.metrics_from) + " s";
   for (const auto& e : opt.exclude) {
     window.exclude.push_back(parse_interval(e));
     description += ", excluding [" + e + "] s";

@@ -4,6 +4,7 @@
 #include <set>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
 namespace {
@@ -116,7 +117,7 @@ bool LogReader::read_row(sim::Sample& s) {
   s.t = csv_.number(col_t_);
   if (have_prev_ && !(s.t > prev_t_)) {
     throw Error(csv_.where(col_t_) + "time must increase (" + std::string(csv_.cell(col_t_)) +
-                " after " + CsvWriter::format(prev_t_) + " on line " + std::to_string(prev_line_) +
+                " after " + format_number(prev_t_) + " on line " + std::to_string(prev_line_) +
                 ")");
   }
   read_vector(col_q_, s.q);

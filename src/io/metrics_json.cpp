@@ -4,7 +4,7 @@
 #include <fstream>
 
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/csv.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
 namespace {
@@ -40,7 +40,7 @@ std::string str(const std::string& s) {
 
 std::string num(double x) {
   if (!std::isfinite(x)) return "null";
-  return CsvWriter::format(x);
+  return format_number(x);
 }
 
 std::string stat(const sim::ErrorStat& s, const char* unit) {

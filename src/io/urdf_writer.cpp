@@ -7,12 +7,12 @@
 #include <set>
 
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/csv.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
 namespace {
 
-std::string num(double x) { return CsvWriter::format(x); }
+std::string num(double x) { return format_number(x); }
 
 std::string vec(const Vector3& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
 
