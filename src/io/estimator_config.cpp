@@ -12,7 +12,6 @@ namespace extwrench {
 namespace {
 
 namespace fs = std::filesystem;
-using io_detail::non_negative;
 using io_detail::positive;
 using io_detail::Range;
 using io_detail::YamlReader;
@@ -98,7 +97,7 @@ void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOp
   }
   rd.only_keys(f, "friction", {"viscous", "coulomb", "smoothing_velocity"});
   JointFriction jf = JointFriction::none(n);
-  const Range coefficient = non_negative();
+  const Range coefficient = io_detail::non_negative();
   if (f["viscous"]) jf.viscous = rd.vector(f["viscous"], "friction.viscous", n, &coefficient);
   if (f["coulomb"]) jf.coulomb = rd.vector(f["coulomb"], "friction.coulomb", n, &coefficient);
   rd.set_number_in(f, "friction", "smoothing_velocity", {0, 1e9, true, "> 0"},

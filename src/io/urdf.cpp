@@ -88,11 +88,8 @@ class UrdfParser {
 
   double number(const XMLElement* e, const char* attr, const std::string& owner,
                 std::optional<double> fallback) const {
-    const char* v = e->Attribute(attr);
-    if (v == nullptr) {
-      if (fallback) return *fallback;
-      fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
-    }
+    if (fallback && e->Attribute(attr) == nullptr) return *fallback;
+    const char* v = required(e, attr, owner);
     const auto d = parse_number(v, kUrdfNumber);
     if (!d)
       fail(e, owner, std::string("attribute '") + attr + "': expected a number, got '" + v + "'");
@@ -101,11 +98,8 @@ class UrdfParser {
 
   Vector3 vector3(const XMLElement* e, const char* attr, const std::string& owner,
                   std::optional<Vector3> fallback) const {
-    const char* v = e->Attribute(attr);
-    if (v == nullptr) {
-      if (fallback) return *fallback;
-      fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
-    }
+    if (fallback && e->Attribute(attr) == nullptr) return *fallback;
+    const char* v = required(e, attr, owner);
     const auto tokens = io_detail::split_ws(v);
     Vector3 out;
     bool ok = tokens.size() == 3;
