@@ -6,7 +6,7 @@
 
 #include "detail/yaml_reader.hpp"
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/csv.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
 namespace {
@@ -294,10 +294,9 @@ namespace {
 
 std::string pose_yaml(const Pose& X) {
   const Vector3 rpy = rpy_from_rotation(X.rotation);
-  return "{xyz: [" + CsvWriter::format(X.translation.x()) + ", " +
-         CsvWriter::format(X.translation.y()) + ", " + CsvWriter::format(X.translation.z()) +
-         "], rpy: [" + CsvWriter::format(rpy.x()) + ", " + CsvWriter::format(rpy.y()) + ", " +
-         CsvWriter::format(rpy.z()) + "]}";
+  return "{xyz: [" + format_number(X.translation.x()) + ", " + format_number(X.translation.y()) +
+         ", " + format_number(X.translation.z()) + "], rpy: [" + format_number(rpy.x()) + ", " +
+         format_number(rpy.y()) + ", " + format_number(rpy.z()) + "]}";
 }
 }  // namespace
 
@@ -306,8 +305,8 @@ std::string scheme_config_yaml(const Scenario& s, const SchemeSpec& scheme) {
   YAML::Node out(YAML::NodeType::Map);
   out["robot"] = "../model_estimator.urdf";
   const Vector3& g = s.robot.model.gravity;
-  out["gravity"] = YAML::Load("[" + CsvWriter::format(g.x()) + ", " + CsvWriter::format(g.y()) +
-                              ", " + CsvWriter::format(g.z()) + "]");
+  out["gravity"] = YAML::Load("[" + format_number(g.x()) + ", " + format_number(g.y()) + ", " +
+                              format_number(g.z()) + "]");
   for (const auto& kv : node) out[kv.first.Scalar()] = kv.second;
   if (out["sensor"]["type"].Scalar() != "none" && !out["sensor"]["pose"]) {
     out["sensor"]["pose"] = YAML::Load(pose_yaml(s.simulation.sensor.X_RS));
