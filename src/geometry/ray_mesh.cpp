@@ -1,0 +1,147 @@
+// Line / triangle-mesh intersection: exact double-precision hits (brute force, or vetting a float
+// ray caster's candidates) and, on a miss, the nearest surface point.
+#include <array>
+#include <cmath>
+
+#include "ray_detail.hpp"
+
+namespace extwrench::ray_detail {
+namespace {
+
+// Barycentric slack of the double-precision triangle test. Brute force: only rounding, so an
+// edge crossing is not lost between two triangles. Candidates from a float ray caster: a hit
+// within float error of an edge may be reported on the neighbour only; such "loose" hits are
+// used only where no exact hit lies within kLooseWindow.
+constexpr double kStrictSlack = 1e-12;
+constexpr double kLooseSlack = 1e-5;
+constexpr double kLooseWindow = 1e-6;  // [m]
+
+/// Exact line / triangle intersection in double (Möller–Trumbore on the infinite line).
+/// Returns false if the line is parallel to the triangle's plane or passes outside it by more
+/// than `slack` in barycentric coordinates.
+bool line_triangle(const TriangleMesh& mesh, int tri, const Vector3& o, const Vector3& u,
+                   double slack, ShapeHit& hit) noexcept {
+  const Vector3 v0 = mesh.vertices.col(mesh.triangles(0, tri));
+  const Vector3 e1 = mesh.vertices.col(mesh.triangles(1, tri)) - v0;
+  const Vector3 e2 = mesh.vertices.col(mesh.triangles(2, tri)) - v0;
+  const Vector3 pv = u.cross(e2);
+  const double det = e1.dot(pv);  // = u·(e1 × e2)
+  // The line lies in the plane (relative to the triangle's size), or the triangle is degenerate.
+  if (!(det * det > 1e-28 * e1.squaredNorm() * e2.squaredNorm())) return false;
+  const double inv_det = 1.0 / det;
+  const Vector3 tv = o - v0;
+  const double b1 = tv.dot(pv) * inv_det;
+  if (b1 < -slack || b1 > 1.0 + slack) return false;
+  const Vector3 qv = tv.cross(e1);
+  const double b2 = u.dot(qv) * inv_det;
+  if (b2 < -slack || b1 + b2 > 1.0 + slack) return false;
+  hit.lambda = e2.dot(qv) * inv_det;
+  hit.point = o + hit.lambda * u;
+  hit.normal = e1.cross(e2).normalized();
+  return true;
+}
+
+struct MeshVisit {
+  const TriangleMesh* mesh;
+  Vector3 o;
+  Vector3 u;
+  HitSink* sink;
+  std::array<ShapeHit, 16> loose;
+  int num_loose = 0;
+  std::array<double, 64> exact;  // λ of exact hits, to vet the loose ones
+  int num_exact = 0;
+};
+
+void visit_candidate(void* user, int tri) noexcept {
+  auto& v = *static_cast<MeshVisit*>(user);
+  if (tri < 0 || tri >= v.mesh->triangles.cols()) return;
+  ShapeHit hit;
+  if (line_triangle(*v.mesh, tri, v.o, v.u, kStrictSlack, hit)) {
+    v.sink->add(hit);
+    if (v.num_exact < static_cast<int>(v.exact.size())) v.exact[v.num_exact++] = hit.lambda;
+  } else if (line_triangle(*v.mesh, tri, v.o, v.u, kLooseSlack, hit)) {
+    if (v.num_loose < static_cast<int>(v.loose.size())) {
+      v.loose[v.num_loose++] = hit;
+    } else {
+      v.sink->add(hit);
+    }
+  }
+}
+
+/// Unit vectors completing u to an orthonormal basis.
+void orthonormal_basis(const Vector3& u, Vector3& e1, Vector3& e2) noexcept {
+  int k = 0;  // the axis least aligned with u
+  u.cwiseAbs().minCoeff(&k);
+  e1 = u.cross(Vector3::Unit(k)).normalized();
+  e2 = u.cross(e1);
+}
+
+}  // namespace
+
+void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u,
+               HitSink& sink) noexcept {
+  if (mesh.ray_caster == nullptr) {
+    ShapeHit hit;
+    for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
+      if (line_triangle(mesh, static_cast<int>(t), o, u, kStrictSlack, hit)) sink.add(hit);
+    }
+    return;
+  }
+  MeshVisit v{&mesh, o, u, &sink, {}, 0, {}, 0};
+  mesh.ray_caster->for_each_line_candidate(o, u, &visit_candidate, &v);
+  // A loose hit is the float caster's pick of the wrong triangle at an edge: keep it only if the
+  // right one was not reported.
+  for (int i = 0; i < v.num_loose; ++i) {
+    bool covered = false;
+    for (int j = 0; j < v.num_exact && !covered; ++j) {
+      covered = std::abs(v.exact[j] - v.loose[i].lambda) <= kLooseWindow;
+    }
+    if (!covered) sink.add(v.loose[i]);
+  }
+}
+
+/// Surface point of a mesh nearest to a line that misses it. The distance from the line to a
+/// point x is |P⊥(x − o)|, so in the plane ⊥ u the line is the origin and each edge a segment:
+/// the 3D line-to-edge distance is a 2D point-to-segment distance. A line missing a triangle is
+/// nearest to it on an edge, hence the scan over edges (shared edges are seen twice).
+ShapeClosestPoint mesh_closest_on_miss(const TriangleMesh& m, const Vector3& o,
+                                       const Vector3& u) noexcept {
+  ShapeClosestPoint cp;
+  cp.distance = kInf;
+  cp.point.setConstant(kNaN);
+  cp.lambda = kNaN;
+  Vector3 e1, e2;
+  orthonormal_basis(u, e1, e2);
+  double best = kInf;
+  Eigen::Index best_t = -1;
+  int best_k = 0;
+  double best_s = 0.0;
+  for (Eigen::Index t = 0; t < m.triangles.cols(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const Vector3 a = m.vertices.col(m.triangles(k, t)) - o;
+      const Vector3 b = m.vertices.col(m.triangles((k + 1) % 3, t)) - o;
+      const double ax = e1.dot(a), ay = e2.dot(a);
+      const double dx = e1.dot(b) - ax, dy = e2.dot(b) - ay;
+      const double dd = dx * dx + dy * dy;
+      double sk = 0.0;
+      if (dd > 0.0) sk = std::clamp(-(ax * dx + ay * dy) / dd, 0.0, 1.0);
+      const double px = ax + sk * dx, py = ay + sk * dy;
+      const double d2 = px * px + py * py;
+      if (d2 < best) {
+        best = d2;
+        best_t = t;
+        best_k = k;
+        best_s = sk;
+      }
+    }
+  }
+  if (best_t < 0) return cp;
+  const Vector3 a = m.vertices.col(m.triangles(best_k, best_t));
+  const Vector3 b = m.vertices.col(m.triangles((best_k + 1) % 3, best_t));
+  cp.point = a + best_s * (b - a);
+  cp.lambda = u.dot(cp.point - o);
+  cp.distance = std::sqrt(best);
+  return cp;
+}
+
+}  // namespace extwrench::ray_detail
