@@ -201,13 +201,40 @@ void validate_model(const Model& model) {
   }
 }
 
-Model ModelBuilder::build() const {
-  const std::string model_where = "robot '" + name_ + "'";
-  if (links_.empty()) throw Error(model_where + ": no links");
-  if (!gravity_.allFinite()) throw Error(model_where + ": gravity: expected finite numbers");
-
-  // --- links: unique names, physical mass properties (in file order: the first bad link wins)
+/// What the link and joint phases learn about the links: their indices by name, each link's
+/// parent joint (-1: none) and child joints, all indices into links_ and joints_.
+struct ModelBuilder::Topology {
   std::map<std::string, int, std::less<>> link_index;
+  std::vector<int> parent_joint;
+  std::vector<std::vector<int>> child_joints;
+};
+
+namespace {
+
+// The Model's joint for a moving spec joint, placed in the body of its parent link.
+Joint to_joint(const JointSpec& js, const Pose& X_body_parent_link) {
+  Joint j;
+  j.name = js.name;
+  j.type = js.type == JointSpecType::kPrismatic ? JointType::kPrismatic : JointType::kRevolute;
+  j.placement = X_body_parent_link * js.origin;
+  j.axis = js.axis.normalized();
+  if (js.type != JointSpecType::kContinuous) {
+    j.lower = js.lower;
+    j.upper = js.upper;
+  }
+  j.velocity_limit = js.velocity_limit;
+  j.effort_limit = js.effort_limit;
+  j.damping = js.damping;
+  j.friction = js.friction;
+  return j;
+}
+
+}  // namespace
+
+// --- links: unique names, physical mass properties (in file order: the first bad link wins)
+ModelBuilder::Topology ModelBuilder::index_links() const {
+  Topology topology;
+  std::map<std::string, int, std::less<>>& link_index = topology.link_index;
   for (std::size_t i = 0; i < links_.size(); ++i) {
     const LinkSpec& l = links_[i];
     const std::string where = prefix(l.source) + "link '" + l.name + "'";
@@ -220,11 +247,17 @@ Model ModelBuilder::build() const {
     validate_inertia(l.inertia, prefix(l.inertia_source.empty() ? l.source : l.inertia_source) +
                                     "link '" + l.name + "'");
   }
+  topology.parent_joint.assign(links_.size(), -1);
+  topology.child_joints.resize(links_.size());
+  return topology;
+}
 
-  // --- joints: names, endpoints, numbers, one parent per link
+// --- joints: names, endpoints, numbers, one parent per link
+void ModelBuilder::connect_joints(Topology& topology) const {
+  const auto& link_index = topology.link_index;
+  std::vector<int>& parent_joint = topology.parent_joint;
+  std::vector<std::vector<int>>& child_joints = topology.child_joints;
   std::set<std::string, std::less<>> joint_names;
-  std::vector<int> parent_joint(links_.size(), -1);
-  std::vector<std::vector<int>> child_joints(links_.size());
   for (std::size_t k = 0; k < joints_.size(); ++k) {
     const JointSpec& j = joints_[k];
     const std::string where = prefix(j.source) + "joint '" + j.name + "'";
@@ -267,36 +300,41 @@ Model ModelBuilder::build() const {
     if (!std::isfinite(j.damping)) throw Error(where + ": dynamics: damping must be finite");
     if (!std::isfinite(j.friction)) throw Error(where + ": dynamics: friction must be finite");
   }
+}
 
-  // --- exactly one root, no cycles
+// The error for a link that no root reaches: every link on the way up has a parent (else it
+// would be reachable from a root), so walking up from `start` closes a cycle.
+std::string ModelBuilder::cycle_message(const Topology& topology, int start) const {
+  const auto& link_index = topology.link_index;
+  const std::vector<int>& parent_joint = topology.parent_joint;
+  std::vector<int> path;
+  std::vector<int> seen_at(links_.size(), -1);
+  int l = start;
+  while (seen_at[static_cast<std::size_t>(l)] < 0) {
+    seen_at[static_cast<std::size_t>(l)] = static_cast<int>(path.size());
+    path.push_back(l);
+    l = link_index
+            .find(
+                joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])].parent)
+            ->second;
+  }
+  std::string chain;
+  const int first = seen_at[static_cast<std::size_t>(l)];
+  for (std::size_t i = path.size(); i-- > static_cast<std::size_t>(first);) {
+    chain += "'" + links_[static_cast<std::size_t>(path[i])].name + "' -> ";
+  }
+  chain += "'" + links_[static_cast<std::size_t>(l)].name + "'";
+  const JointSpec& j = joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])];
+  return prefix(j.source) + "joint '" + j.name + "': closes a cycle of links: " + chain;
+}
+
+// --- exactly one root, no cycles
+int ModelBuilder::find_root(const Topology& topology) const {
   std::vector<int> roots;
   for (std::size_t i = 0; i < links_.size(); ++i) {
-    if (parent_joint[i] < 0) roots.push_back(static_cast<int>(i));
+    if (topology.parent_joint[i] < 0) roots.push_back(static_cast<int>(i));
   }
-  auto describe_cycle = [&](int start) {
-    // Every link on the way has a parent (else it would be reachable from a root): walk up.
-    std::vector<int> path;
-    std::vector<int> seen_at(links_.size(), -1);
-    int l = start;
-    while (seen_at[static_cast<std::size_t>(l)] < 0) {
-      seen_at[static_cast<std::size_t>(l)] = static_cast<int>(path.size());
-      path.push_back(l);
-      l = link_index
-              .find(joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])]
-                        .parent)
-              ->second;
-    }
-    std::string chain;
-    const int first = seen_at[static_cast<std::size_t>(l)];
-    for (std::size_t i = path.size(); i-- > static_cast<std::size_t>(first);) {
-      chain += "'" + links_[static_cast<std::size_t>(path[i])].name + "' -> ";
-    }
-    chain += "'" + links_[static_cast<std::size_t>(l)].name + "'";
-    const JointSpec& j =
-        joints_[static_cast<std::size_t>(parent_joint[static_cast<std::size_t>(l)])];
-    return Error(prefix(j.source) + "joint '" + j.name + "': closes a cycle of links: " + chain);
-  };
-  if (roots.empty()) throw describe_cycle(0);
+  if (roots.empty()) throw Error(cycle_message(topology, 0));
   if (roots.size() > 1) {
     const LinkSpec& a = links_[static_cast<std::size_t>(roots[0])];
     const LinkSpec& b = links_[static_cast<std::size_t>(roots[1])];
@@ -304,8 +342,12 @@ Model ModelBuilder::build() const {
                 "' at " + a.source + " and '" + b.name +
                 "' have no parent joint); the links must form one tree");
   }
+  return roots[0];
+}
 
-  // --- depth-first traversal: a moving joint starts a new body, a fixed one merges its child
+// --- depth-first traversal: a moving joint starts a new body, a fixed one merges its child
+Model ModelBuilder::traverse(const Topology& topology, int root,
+                             std::vector<std::string>& body_source) const {
   Model model;
   model.name = name_;
   model.gravity = gravity_;
@@ -315,9 +357,8 @@ Model ModelBuilder::build() const {
     int parent_body;          // body of the joint's parent link
     Pose X_body_parent_link;  // pose of the parent link in that body
   };
-  std::vector<Item> stack{{roots[0], -1, -1, Pose::identity()}};
+  std::vector<Item> stack{{root, -1, -1, Pose::identity()}};
   std::vector<bool> visited(links_.size(), false);
-  std::vector<std::string> body_source;  // for the mass-matrix error
   while (!stack.empty()) {
     const Item it = stack.back();
     stack.pop_back();
@@ -332,27 +373,14 @@ Model ModelBuilder::build() const {
       b.name = l.name;
       model.bodies.push_back(b);
       model.parents.push_back(it.parent_body);
-      Joint j;
       if (js != nullptr) {
-        j.name = js->name;
-        j.type =
-            js->type == JointSpecType::kPrismatic ? JointType::kPrismatic : JointType::kRevolute;
-        j.placement = it.X_body_parent_link * js->origin;
-        j.axis = js->axis.normalized();
-        if (js->type != JointSpecType::kContinuous) {
-          j.lower = js->lower;
-          j.upper = js->upper;
-        }
-        j.velocity_limit = js->velocity_limit;
-        j.effort_limit = js->effort_limit;
-        j.damping = js->damping;
-        j.friction = js->friction;
+        model.joints.push_back(to_joint(*js, it.X_body_parent_link));
         body_source.push_back(prefix(js->source) + "joint '" + js->name + "' (" +
                               type_name(js->type) + ") moving link '" + l.name + "'");
       } else {
+        model.joints.push_back(Joint{});
         body_source.push_back(prefix(l.source) + "link '" + l.name + "'");
       }
-      model.joints.push_back(j);
     } else {
       body = it.parent_body;
       X_body_link = it.X_body_parent_link * js->origin;
@@ -360,17 +388,21 @@ Model ModelBuilder::build() const {
     model.frames.push_back(Frame{l.name, body, X_body_link});
     Body& b = model.bodies[static_cast<std::size_t>(body)];
     b.inertia = b.inertia + l.inertia.transformed(X_body_link);
-    const auto& children = child_joints[static_cast<std::size_t>(it.link)];
+    const auto& children = topology.child_joints[static_cast<std::size_t>(it.link)];
     for (auto c = children.rbegin(); c != children.rend(); ++c) {
-      const int child = link_index.find(joints_[static_cast<std::size_t>(*c)].child)->second;
+      const int child =
+          topology.link_index.find(joints_[static_cast<std::size_t>(*c)].child)->second;
       stack.push_back(Item{child, *c, body, X_body_link});
     }
   }
   for (std::size_t i = 0; i < links_.size(); ++i) {
-    if (!visited[i]) throw describe_cycle(static_cast<int>(i));
+    if (!visited[i]) throw Error(cycle_message(topology, static_cast<int>(i)));
   }
+  return model;
+}
 
-  // --- extra frames
+// --- extra frames
+void ModelBuilder::add_extra_frames(Model& model) const {
   for (const FrameSpec& f : frames_) {
     const std::string where = prefix(f.source) + "frame '" + f.name + "'";
     if (f.name.empty()) throw Error(prefix(f.source) + "frame: name must not be empty");
@@ -384,8 +416,11 @@ Model ModelBuilder::build() const {
     const Frame& parent = model.frames[static_cast<std::size_t>(*lf)];
     model.frames.push_back(Frame{f.name, parent.body, parent.placement * f.placement});
   }
+}
 
-  // --- a massless body is fine only if M(q = 0) stays positive definite
+// --- a massless body is fine only if M(q = 0) stays positive definite
+void ModelBuilder::check_massless_bodies(const Model& model,
+                                         const std::vector<std::string>& body_source) {
   const int bad = singular_mass_matrix_body(model);
   if (bad > 0) {
     throw Error(
@@ -394,6 +429,19 @@ Model ModelBuilder::build() const {
         "moves carry no mass or inertia about its axis (give the child link an <inertial>, or "
         "make the joint fixed)");
   }
+}
+
+Model ModelBuilder::build() const {
+  const std::string model_where = "robot '" + name_ + "'";
+  if (links_.empty()) throw Error(model_where + ": no links");
+  if (!gravity_.allFinite()) throw Error(model_where + ": gravity: expected finite numbers");
+  Topology topology = index_links();
+  connect_joints(topology);
+  const int root = find_root(topology);
+  std::vector<std::string> body_source;  // for the mass-matrix error
+  Model model = traverse(topology, root, body_source);
+  add_extra_frames(model);
+  check_massless_bodies(model, body_source);
   validate_model(model);
   return model;
 }

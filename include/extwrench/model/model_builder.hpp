@@ -58,6 +58,18 @@ class ModelBuilder {
   [[nodiscard]] Model build() const;
 
  private:
+  // The steps of build, in order; each throws at the first bad element it meets.
+  struct Topology;  // links by name, each link's parent and child joints (model_builder.cpp)
+  [[nodiscard]] Topology index_links() const;
+  void connect_joints(Topology& topology) const;
+  [[nodiscard]] int find_root(const Topology& topology) const;
+  [[nodiscard]] Model traverse(const Topology& topology, int root,
+                               std::vector<std::string>& body_source) const;
+  void add_extra_frames(Model& model) const;
+  static void check_massless_bodies(const Model& model,
+                                    const std::vector<std::string>& body_source);
+  [[nodiscard]] std::string cycle_message(const Topology& topology, int start) const;
+
   std::string name_;
   Vector3 gravity_{0.0, 0.0, -9.81};
   std::vector<LinkSpec> links_;
