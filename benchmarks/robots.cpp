@@ -13,54 +13,15 @@
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "extwrench/model/sample_models.hpp"
 #include "support/paper_arm_table.hpp"
 
 namespace extwrench::bench {
 namespace {
 
-// SPEC §5's table, shared with the tests.
+// The paper's table as the tests write it, for KDL's chain: an independent copy of the numbers
+// that the library's paper_arm() is built from.
 using namespace test::paper_arm_table;
-
-Pose dh_pose(double d, double alpha) {  // Tz(d) Rx(alpha); the Rz(q) is the joint's motion
-  Pose x;
-  x.translation = Vector3(0, 0, d);
-  x.rotation = Eigen::AngleAxisd(alpha, Vector3::UnitX()).toRotationMatrix();
-  return x;
-}
-
-// Body i's frame is DH frame i-1 turned by q_i (z = joint i's axis), as a URDF would place it.
-Model paper_arm_model_from_dh() {
-  Model m;
-  m.name = "paper_arm";
-  m.bodies.resize(8);
-  m.joints.resize(8);
-  m.parents.resize(8);
-  m.parents[0] = -1;
-  m.bodies[0].name = "link0";
-  m.bodies[0].inertia.mass = kLink0Mass;
-  m.bodies[0].inertia.com = Vector3(0, 0, kLink0ComZ);
-  m.bodies[0].inertia.inertia_com =
-      Vector3(kLink0Inertia[0], kLink0Inertia[1], kLink0Inertia[2]).asDiagonal();
-  m.frames.push_back({"link0", 0, Pose{}});
-  for (int i = 1; i <= 7; ++i) {
-    const int k = i - 1;
-    m.parents[i] = i - 1;
-    Joint& j = m.joints[i];
-    j.name = "joint" + std::to_string(i);
-    j.axis = Vector3::UnitZ();
-    j.placement = i == 1 ? dh_pose(kLink0Height, 0.0) : dh_pose(kD[k - 1], kAlpha[k - 1]);
-    Inertia in_dh;
-    in_dh.mass = kMass[k];
-    in_dh.com = Vector3(kComCm[k][0], kComCm[k][1], kComCm[k][2]) * 1e-2;
-    const double* c = kInertiaGm2[k];
-    in_dh.inertia_com << c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5];
-    in_dh.inertia_com *= 1e-3;
-    m.bodies[i].name = "link" + std::to_string(i);
-    m.bodies[i].inertia = in_dh.transformed(dh_pose(kD[k], kAlpha[k]));
-    m.frames.push_back({m.bodies[i].name, i, Pose{}});
-  }
-  return m;
-}
 
 KDL::Chain paper_arm_chain_from_dh() {
   KDL::Chain chain;
@@ -139,9 +100,9 @@ PaperArm load_paper_arm() {
     }
     arm.source = "models/paper_arm.urdf (ours: load_urdf; KDL: kdl_parser::treeFromFile)";
   } else {
-    arm.model = paper_arm_model_from_dh();
+    arm.model = extwrench::paper_arm();
     arm.chain = paper_arm_chain_from_dh();
-    arm.source = "SPEC 5 DH table in code (ours: Model; KDL: Frame::DH)";
+    arm.source = "the paper's DH table in code (ours: paper_arm(); KDL: Frame::DH)";
   }
   if (!has_shapes(arm.geometry, arm.model.num_bodies())) arm.geometry = capsules(arm.model);
   return arm;

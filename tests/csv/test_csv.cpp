@@ -272,9 +272,8 @@ TEST(CsvWriter, DoublesReadBackBitForBit) {
                                 9007199254740993.0,
                                 123456789.123456789};
   // Random bit patterns cover every exponent; non-finite ones are handled separately.
-  std::uniform_int_distribution<std::uint64_t> bits;
   while (values.size() < 5000) {
-    const double v = std::bit_cast<double>(bits(rng.engine()));
+    const double v = std::bit_cast<double>(rng.bits());
     if (std::isfinite(v)) values.push_back(v);
   }
   std::stringstream io;

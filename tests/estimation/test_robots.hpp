@@ -13,63 +13,14 @@
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/geometry/shapes.hpp"
-#include "support/paper_arm_table.hpp"
+#include "extwrench/model/sample_models.hpp"
 #include "support/random.hpp"
-#include "support/random_model.hpp"
 
 namespace extwrench::test {
 
-inline Pose dh_transform(double d, double alpha) {
-  // Standard DH with a = 0 and θ folded into the joint: Tz(d) Rx(α).
-  Pose x;
-  x.translation = Vector3(0, 0, d);
-  x.rotation = Eigen::AngleAxisd(alpha, Vector3::UnitX()).toRotationMatrix();
-  return x;
-}
-
-/// The paper's 7R arm (SPEC §5): standard DH, Table II (signs restored), link 0 on the sensor.
-/// Body i's frame sits at DH origin O_{i−1} with z along joint i's axis (it is DH frame i−1
-/// turned by q_i); frame "dh<i>" is DH frame i, attached to body i.
-inline Model paper_arm_model() {
-  using namespace paper_arm_table;
-  Model m;
-  m.name = "paper_arm";
-  m.bodies.resize(8);
-  m.joints.resize(8);
-  m.parents.resize(8);
-  m.parents[0] = -1;
-  m.bodies[0].name = "link0";
-  m.bodies[0].inertia.mass = kLink0Mass;
-  m.bodies[0].inertia.com = Vector3(0, 0, kLink0ComZ);
-  m.bodies[0].inertia.inertia_com =
-      Vector3(kLink0Inertia[0], kLink0Inertia[1], kLink0Inertia[2]).asDiagonal();
-  m.frames.push_back({"link0", 0, Pose{}});
-  for (int i = 1; i <= 7; ++i) {
-    const int k = i - 1;
-    m.parents[i] = i - 1;
-    Joint& j = m.joints[i];
-    j.name = "joint" + std::to_string(i);
-    j.axis = Vector3::UnitZ();
-    if (i == 1) {
-      j.placement.translation = Vector3(0, 0, kLink0Height);
-    } else {
-      j.placement = dh_transform(kD[k - 1], kAlpha[k - 1]);
-    }
-    Inertia dh;
-    dh.mass = kMass[k];
-    dh.com = Vector3(kComCm[k][0], kComCm[k][1], kComCm[k][2]) * 1e-2;
-    Matrix3 I;
-    const double* in = kInertiaGm2[k];
-    I << in[0], in[1], in[2], in[1], in[3], in[4], in[2], in[4], in[5];
-    dh.inertia_com = I * 1e-3;
-    const Pose X_B_dh = dh_transform(kD[k], kAlpha[k]);
-    m.bodies[i].name = "link" + std::to_string(i);
-    m.bodies[i].inertia = dh.transformed(X_B_dh);
-    m.frames.push_back({m.bodies[i].name, i, Pose{}});
-    m.frames.push_back({"dh" + std::to_string(i), i, X_B_dh});
-  }
-  return m;
-}
+// The estimation tests' names for the library's sample models (model/sample_models.hpp).
+inline Model paper_arm_model() { return paper_arm(); }
+inline Model random_model(const RandomChainOptions& options) { return random_chain(options); }
 
 /// Capsules around the paper arm's links (radius in m): each link from its body origin to the
 /// next DH origin; zero-length links are spheres.

@@ -8,15 +8,15 @@
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/model/sample_models.hpp"
 #include "extwrench/sim/metrics.hpp"
 #include "extwrench/sim/perturb.hpp"
 #include "extwrench/sim/simulator.hpp"
-#include "support/random_model.hpp"
+#include "support/random.hpp"
 
 namespace extwrench::sim {
 namespace {
 
-using test::RandomModelOptions;
 using test::SeededRng;
 
 // RK4 at 1e-3 s on these arms: local error ~ h^5 · (rate)^5 ~ 1e-12 per step.
@@ -37,7 +37,7 @@ double potential_energy(const Model& model, Data& data, const VectorX& q) {
 }
 
 TEST(Rk4, ConservesTheEnergyOfAnUnactuatedArm) {
-  const Model model = test::random_model({.n = 7, .seed = 3});
+  const Model model = random_chain({.n = 7, .seed = 3});
   Rk4Workspace ws(model);
   Data data(model);
   SeededRng rng(5);
@@ -51,7 +51,7 @@ TEST(Rk4, ConservesTheEnergyOfAnUnactuatedArm) {
 }
 
 TEST(Rk4, EnergyChangeEqualsTheWorkOfTorquesAndExternalForces) {
-  const Model model = test::random_model({.n = 5, .seed = 8});
+  const Model model = random_chain({.n = 5, .seed = 8});
   std::vector<ForceProfile> forces(1);
   forces[0].frame = "link4";
   forces[0].axes = ForceProfile::Axes::kWorld;
@@ -85,7 +85,7 @@ TEST(Rk4, EnergyChangeEqualsTheWorkOfTorquesAndExternalForces) {
 }
 
 TEST(Rk4, ErrorShrinksWithTheFourthPowerOfTheStep) {
-  const Model model = test::random_model({.n = 4, .seed = 2});
+  const Model model = random_chain({.n = 4, .seed = 2});
   Rk4Workspace ws(model);
   SeededRng rng(4);
   const VectorX q0 = rng.uniform_vector(4, -1, 1);
@@ -106,7 +106,7 @@ TEST(Rk4, ErrorShrinksWithTheFourthPowerOfTheStep) {
 }
 
 TEST(Simulator, TrueAccelerationSatisfiesInverseDynamicsWithTheExternalWrench) {
-  const Model model = test::random_model({.n = 7, .seed = 12});
+  const Model model = random_chain({.n = 7, .seed = 12});
   std::vector<ForceProfile> forces(2);
   forces[0].frame = "link6";
   forces[0].force = Vector3(20, 0, 0);
@@ -151,7 +151,7 @@ TEST(ForceProfile, RampsUpAndDownInsideItsWindow) {
 }
 
 TEST(ForceProfile, FrameForceTurnsWithTheLinkAndWorldForceDoesNot) {
-  const Model model = test::random_model({.n = 3, .seed = 21});
+  const Model model = random_chain({.n = 3, .seed = 21});
   Data data(model);
   forward_kinematics(model, data, VectorX::Constant(3, 0.7));
   ForceProfile in_frame;
@@ -172,7 +172,7 @@ TEST(ForceProfile, FrameForceTurnsWithTheLinkAndWorldForceDoesNot) {
 }
 
 TEST(ForceProfile, UnknownFrameIsAnErrorNamingIt) {
-  const Model model = test::random_model({.n = 2, .seed = 1});
+  const Model model = random_chain({.n = 2, .seed = 1});
   ForceProfile f;
   f.frame = "tool0";
   try {
@@ -227,7 +227,7 @@ TEST(SensorModel, NoiseHasTheConfiguredBiasAndStandardDeviation) {
 }
 
 TEST(PerturbModel, EveryEntryStaysWithinTheFractionAndZerosStayZero) {
-  Model model = test::random_model({.n = 7, .seed = 30});
+  Model model = random_chain({.n = 7, .seed = 30});
   model.bodies[3].inertia.com.y() = 0.0;
   model.bodies[5].inertia.inertia_com(0, 1) = model.bodies[5].inertia.inertia_com(1, 0) = 0.0;
   const Model p = perturb_model(model, 0.01, 42);
@@ -251,7 +251,7 @@ TEST(PerturbModel, EveryEntryStaysWithinTheFractionAndZerosStayZero) {
 }
 
 TEST(PerturbModel, IsDeterministicPerSeed) {
-  const Model model = test::random_model({.n = 4, .seed = 31});
+  const Model model = random_chain({.n = 4, .seed = 31});
   const Model a = perturb_model(model, 0.01, 5);
   const Model b = perturb_model(model, 0.01, 5);
   const Model c = perturb_model(model, 0.01, 6);
@@ -270,7 +270,7 @@ SinusoidalTrajectory small_sinusoid(int n) {
 }
 
 TEST(Controller, ComputedTorqueWithTheExactModelTracksTheTrajectory) {
-  const Model model = test::random_model({.n = 6, .seed = 40});
+  const Model model = random_chain({.n = 6, .seed = 40});
   ComputedTorqueController ctl(model, small_sinusoid(6), pid_gains_triple_pole(6, 20.0));
   SimulationConfig cfg;
   cfg.duration = 1.0;
@@ -293,7 +293,7 @@ TEST(Controller, ComputedTorqueWithTheExactModelTracksTheTrajectory) {
 TEST(Controller, IntegralTermRecoversThePathUnderAConstantForce) {
   // A set point and a world-frame force: the disturbance is constant in joint space, so the
   // integral term must bring the error back to zero (the paper's "recovers the path").
-  const Model model = test::random_model({.n = 6, .seed = 41});
+  const Model model = random_chain({.n = 6, .seed = 41});
   SinusoidalTrajectory tr = small_sinusoid(6);
   tr.amplitude.setZero();
   ComputedTorqueController ctl(perturb_model(model, 0.01, 3), tr, pid_gains_triple_pole(6, 10.0));
@@ -329,7 +329,7 @@ TEST(Simulator, BaseReadingEqualsWeightPlusForceForARobotHeldAtRest) {
   // a world-frame force balanced by nothing accelerates the arm; at t = 0 with q̇ = 0 the reading
   // is f_m = m g⃗ + F − Σ m_i a_ci. Check the force part with a force on link 0, which does not
   // move the arm: f_m = m g⃗ + F exactly.
-  const Model model = test::random_model({.n = 3, .seed = 50});
+  const Model model = random_chain({.n = 3, .seed = 50});
   SinusoidalTrajectory tr = small_sinusoid(3);
   tr.amplitude.setZero();
   ComputedTorqueController ctl(model, tr, pid_gains_triple_pole(3, 10.0));
