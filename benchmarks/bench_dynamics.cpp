@@ -11,6 +11,7 @@
 
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "robots.hpp"
 

@@ -4,6 +4,40 @@
 
 namespace extwrench {
 
+namespace {
+
+/// The cached rotation terms of one joint (see Data::rotation_const), written once here so that
+/// the constructor and Data::matches derive them the same way.
+struct JointRotation {
+  Matrix3 rotation_const = Matrix3::Identity();
+  Matrix3 rotation_cos = Matrix3::Zero();
+  Matrix3 rotation_sin = Matrix3::Zero();
+  Vector3 axis_P = Vector3::Zero();
+};
+
+JointRotation joint_rotation(const Joint& joint) {
+  JointRotation out;
+  const Matrix3& P = joint.placement.rotation;
+  const Vector3& a = joint.axis;
+  out.axis_P = P * a;
+  if (joint.type == JointType::kRevolute) {
+    const Matrix3 aaT = a * a.transpose();
+    out.rotation_const = P * aaT;
+    out.rotation_cos = P * (Matrix3::Identity() - aaT);
+    out.rotation_sin = P * skew(a);
+  } else {
+    out.rotation_const = P;
+  }
+  return out;
+}
+
+template <typename T>
+bool sized(const std::vector<T>& v, std::size_t size) {
+  return v.size() == size;
+}
+
+}  // namespace
+
 Data::Data(const Model& model) {
   const auto nb = static_cast<std::size_t>(model.num_bodies());
   const int n = model.nq();
@@ -12,18 +46,11 @@ Data::Data(const Model& model) {
   rotation_sin.assign(nb, Matrix3::Zero());
   axis_P.assign(nb, Vector3::Zero());
   for (std::size_t i = 1; i < nb && i < model.joints.size(); ++i) {
-    const Joint& joint = model.joints[i];
-    const Matrix3& P = joint.placement.rotation;
-    const Vector3& a = joint.axis;
-    axis_P[i] = P * a;
-    if (joint.type == JointType::kRevolute) {
-      const Matrix3 aaT = a * a.transpose();
-      rotation_const[i] = P * aaT;
-      rotation_cos[i] = P * (Matrix3::Identity() - aaT);
-      rotation_sin[i] = P * skew(a);
-    } else {
-      rotation_const[i] = P;
-    }
+    const JointRotation r = joint_rotation(model.joints[i]);
+    rotation_const[i] = r.rotation_const;
+    rotation_cos[i] = r.rotation_cos;
+    rotation_sin[i] = r.rotation_sin;
+    axis_P[i] = r.axis_P;
   }
   X_WB.assign(nb, Pose{});
   S.assign(nb, Vector6::Zero());
@@ -55,6 +82,32 @@ Data::Data(const Model& model) {
   // Sized by a factorization rather than by copying LLT(n), whose ComputationInfo is left
   // uninitialized by Eigen (UBSan: invalid enum load in the copy).
   mass_llt.compute(MatrixX::Identity(n, n));
+}
+
+bool Data::matches(const Model& model) const {
+  const auto nb = static_cast<std::size_t>(model.num_bodies());
+  const Eigen::Index n = model.nq();
+  const bool bodies_sized =
+      sized(rotation_const, nb) && sized(rotation_cos, nb) && sized(rotation_sin, nb) &&
+      sized(axis_P, nb) && sized(X_WB, nb) && sized(S, nb) && sized(mass, nb) &&
+      sized(first_moment_W, nb) && sized(inertia_O_W, nb) && sized(v, nb) && sized(a, nb) &&
+      sized(f, nb) && sized(h, nb) && sized(bias_f, nb) && sized(composite_mass, nb) &&
+      sized(composite_first_moment, nb) && sized(composite_inertia_O, nb) && sized(Ic, nb) &&
+      sized(Bc, nb) && sized(Sdot, nb);
+  const bool joints_sized = tau.size() == n && M.rows() == n && M.cols() == n && C.rows() == n &&
+                            C.cols() == n && momentum.size() == n &&
+                            coriolis_transpose_dq.size() == n && gravity_torque.size() == n &&
+                            ddq.size() == n && J.cols() == n && tmp_n.size() == n &&
+                            sin_q.size() == n && cos_q.size() == n;
+  if (!bodies_sized || !joints_sized) return false;
+  for (std::size_t i = 1; i < nb && i < model.joints.size(); ++i) {
+    const JointRotation r = joint_rotation(model.joints[i]);
+    if (r.rotation_const != rotation_const[i] || r.rotation_cos != rotation_cos[i] ||
+        r.rotation_sin != rotation_sin[i] || r.axis_P != axis_P[i]) {
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace extwrench

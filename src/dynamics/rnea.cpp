@@ -181,4 +181,35 @@ const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<
   return data.gravity_torque;
 }
 
+const MatrixX& coriolis_matrix(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                               const Eigen::Ref<const VectorX>& dq) {
+  forward_kinematics(model, data, q);
+  const int nb = model.num_bodies();
+  data.v[0].setZero();
+  for (int i = 1; i < nb; ++i) {
+    data.v[i] = data.v[model.parents[i]] + data.S[i] * dq[i - 1];
+    data.Sdot[i] = detail::cross_motion(data.v[i], data.S[i]);
+  }
+  for (int i = 0; i < nb; ++i) {
+    data.Ic[i] = detail::inertia_matrix(data.mass[i], data.first_moment_W[i], data.inertia_O_W[i]);
+    data.Bc[i] = detail::cross_force_matrix(data.v[i]) * data.Ic[i];
+  }
+  data.C.setZero();
+  // C = sum_k J_k^T (I_k J_dot_k + (v_k x*) I_k J_k), so that B_dot = C + C^T. With composites
+  // Ic_i, Bc_i over the subtree of i, for every ancestor j of i (j = i included):
+  //   C_ij = S_i^T (Ic_i S_dot_j + Bc_i S_j),  C_ji = S_j^T (Ic_i S_dot_i + Bc_i S_i).
+  for (int i = nb - 1; i > 0; --i) {
+    const Vector6 Fi = data.Ic[i] * data.Sdot[i] + data.Bc[i] * data.S[i];
+    const Vector6 Si_Ic = data.Ic[i].transpose() * data.S[i];
+    const Vector6 Si_Bc = data.Bc[i].transpose() * data.S[i];
+    for (int j = i; j > 0; j = model.parents[j]) {
+      data.C(i - 1, j - 1) = Si_Ic.dot(data.Sdot[j]) + Si_Bc.dot(data.S[j]);
+      data.C(j - 1, i - 1) = data.S[j].dot(Fi);
+    }
+    const int p = model.parents[i];
+    data.Ic[p] += data.Ic[i];
+    data.Bc[p] += data.Bc[i];
+  }
+  return data.C;
+}
 }  // namespace extwrench

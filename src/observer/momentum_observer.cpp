@@ -4,8 +4,8 @@
 #include <string>
 
 #include "extwrench/core/error.hpp"
-#include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 
 namespace extwrench {
 namespace {

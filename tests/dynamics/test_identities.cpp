@@ -4,13 +4,15 @@
 
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/dynamics/rnea.hpp"
-#include "support/random_model.hpp"
+#include "extwrench/model/sample_models.hpp"
+#include "momentum_oracle.hpp"
+#include "support/random.hpp"
 
 namespace extwrench {
 namespace {
 
-using test::RandomModelOptions;
 using test::SeededRng;
 
 // Central differences with step 1e-6 have truncation error ~1e-12 * third derivative and
@@ -23,12 +25,12 @@ constexpr int kStates = 200;
 
 struct Case {
   const char* name;
-  RandomModelOptions options;
+  RandomChainOptions options;
 };
 
 class DynamicsIdentities : public ::testing::TestWithParam<Case> {
  protected:
-  void SetUp() override { model_ = test::random_model(GetParam().options); }
+  void SetUp() override { model_ = random_chain(GetParam().options); }
   Model model_;
 };
 
@@ -96,6 +98,25 @@ TEST_P(DynamicsIdentities, MomentumTermsMatchMassMatrixAndGravity) {
     momentum_terms(model_, data, q, dq);
     EXPECT_LE((data.momentum - b_dq).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(b_dq));
     EXPECT_LE((data.gravity_torque - g).cwiseAbs().maxCoeff(), kAlgebraicTol * scale(g));
+  }
+}
+
+TEST_P(DynamicsIdentities, MomentumPassMatchesTheSixVectorOracle) {
+  Data data(model_);
+  Data oracle(model_);
+  SeededRng rng(16);
+  const int n = model_.nq();
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
+    momentum_terms(model_, data, q, dq);
+    forward_kinematics(model_, oracle, q);
+    test::momentum_terms_oracle(model_, oracle, dq);
+    EXPECT_LE((data.momentum - oracle.momentum).cwiseAbs().maxCoeff(),
+              kAlgebraicTol * scale(oracle.momentum));
+    EXPECT_LE((data.coriolis_transpose_dq - oracle.coriolis_transpose_dq).cwiseAbs().maxCoeff(),
+              kAlgebraicTol * scale(oracle.coriolis_transpose_dq));
+    EXPECT_LE((data.gravity_torque - oracle.gravity_torque).cwiseAbs().maxCoeff(),
+              kAlgebraicTol * scale(oracle.gravity_torque));
   }
 }
 

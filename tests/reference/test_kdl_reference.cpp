@@ -38,6 +38,7 @@
 
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "reference/reference_util.hpp"

@@ -14,6 +14,7 @@
 
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/robot_loader.hpp"

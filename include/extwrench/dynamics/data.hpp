@@ -15,6 +15,11 @@ namespace extwrench {
 struct Data {
   explicit Data(const Model& model);
 
+  /// True if this Data was sized for `model` and its cached joint rotations (rotation_const,
+  /// rotation_cos, rotation_sin, axis_P) are those of model's joints: a Data built for one
+  /// Model is not valid for another of the same size whose joint axes or placements differ.
+  [[nodiscard]] bool matches(const Model& model) const;
+
   // --- derived from the model once, for the hot path ---
   /// Joint i's rotation from the parent body frame as E_i(q) = rotation_const + cos q ·
   /// rotation_cos + sin q · rotation_sin (Rodrigues premultiplied by the placement rotation P_i:

@@ -1,4 +1,5 @@
-// Recursive Newton-Euler with external wrenches and the base iteration (SPEC section 3).
+// Recursive Newton-Euler with external wrenches and the base iteration, and the terms built on
+// it: bias and gravity torques, the Coriolis matrix, the base sensor reading (docs/algorithms.md).
 #pragma once
 
 #include <span>
@@ -48,5 +49,10 @@ const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<con
 
 /// Gravity torques g(q) into data.gravity_torque.
 const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q);
+
+/// Coriolis matrix C(q, dq) into data.C, the factorization with B_dot = C + C^T
+/// (C = sum_k J_k^T (I_k J_dot_k + (v_k x*) I_k J_k)). Runs forward_kinematics.
+const MatrixX& coriolis_matrix(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
+                               const Eigen::Ref<const VectorX>& dq);
 
 }  // namespace extwrench
