@@ -9,9 +9,9 @@
 #include <utility>
 #include <vector>
 
-#include "alloc_counter.hpp"
 #include "extwrench/geometry/shapes.hpp"
 #include "extwrench/model/model.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace extwrench::bench {
 
@@ -82,9 +82,9 @@ void register_contact_benchmarks();
 template <class F>
 double allocations_per_call(F&& f, int calls = 1000) {
   f(0);
-  const std::size_t before = allocation_count();
+  const std::size_t before = test::allocation_count();
   for (int i = 0; i < calls; ++i) f(i);
-  return static_cast<double>(allocation_count() - before) / calls;
+  return static_cast<double>(test::allocation_count() - before) / calls;
 }
 
 }  // namespace extwrench::bench

@@ -73,6 +73,8 @@ namespace extwrench::test {
 
 bool allocation_counting_available() { return EXTWRENCH_COUNT_ALLOCATIONS != 0; }
 
+std::size_t allocation_count() noexcept { return g_allocations.load(); }
+
 AllocationCounter::AllocationCounter() : start_(g_allocations.load()) {}
 
 std::size_t AllocationCounter::count() const { return g_allocations.load() - start_; }
