@@ -42,7 +42,8 @@ void BM_Rnea_Ours(benchmark::State& state) {
 }
 BENCHMARK(BM_Rnea_Ours);
 
-// Joint torques and the base sensor's wrench (SPEC §3 iteration down to link 0, f_m = −f_0).
+// Joint torques and the base sensor's wrench (the base iteration down to link 0, f_m = −f_0,
+// docs/method.md).
 void BM_RneaBaseWrench_Ours(benchmark::State& state) {
   const PaperArm& arm = paper_arm();
   const StatePool& s = state_pool();
@@ -147,7 +148,7 @@ BENCHMARK(BM_Jacobian_Kdl);
 
 // ---- the model terms of the residual (4): B q̇, Cᵀq̇, g ------------------------------------
 
-// O(n) recursions over link momenta (SPEC §2).
+// O(n) recursions over link momenta (docs/algorithms.md).
 void BM_MomentumTerms_Ours(benchmark::State& state) {
   const PaperArm& arm = paper_arm();
   const StatePool& s = state_pool();

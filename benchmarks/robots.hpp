@@ -15,7 +15,7 @@
 
 namespace extwrench::bench {
 
-/// The paper's 7R arm (SPEC §5) for both libraries: from models/paper_arm.urdf (our loader and
+/// The paper's 7R arm (Table II) for both libraries: from models/paper_arm.urdf (our loader and
 /// kdl_parser::treeFromFile) when the file exists, otherwise built in code from the DH table
 /// (our Model by hand, KDL's chain with KDL::Frame::DH). Either way, set-up checks that KDL's
 /// RNE and ours agree on the seeded states (throws otherwise).

@@ -64,7 +64,8 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
   data.S[0].setZero();
   data.v[0].setZero();
   data.a[0].setZero();
-  data.a[0].head<3>() = -model.gravity;  // gravity trick: the base accelerates with -g (SPEC 3)
+  // Gravity trick: the base accelerates with -g (docs/method.md).
+  data.a[0].head<3>() = -model.gravity;
   {
     // Link 0 is at rest in the world frame: f_0 = [m (-g); c x m (-g)].
     const Inertia& inertia = model.bodies[0].inertia;
@@ -123,7 +124,7 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
                                   const Eigen::Ref<const VectorX>& ddq,
                                   std::span<const ExternalWrench> external, bool with_gravity) {
   const int nb = model.num_bodies();
-  // Forward pass. Gravity trick: the base accelerates with -g (SPEC 3).
+  // Forward pass. Gravity trick: the base accelerates with -g (docs/method.md).
   data.v[0].setZero();
   data.a[0].setZero();
   if (with_gravity) data.a[0].head<3>() = -model.gravity;

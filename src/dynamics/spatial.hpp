@@ -150,7 +150,7 @@ template <bool with_acceleration>
   w += vj_ang;
 }
 
-/// SPEC (7)-(8) for one body about its CoM c (world), with the constant body-axes inertia I_c so
+/// Eqs. (7)-(8) for one body about its CoM c (world), with the constant body-axes inertia I_c so
 /// that no world inertia R I_c R^T is formed: F = m c_ddot, N_c = R (I_c w_dot_B + w_B x I_c w_B),
 /// moved to the world origin: [F; N] = [F; N_c + c x F] (= I_i a_i + v_i x* I_i v_i). c_ddot =
 /// a_O + w_dot x c + w x v_c turns the spatial acceleration at the world origin into the classical

@@ -1,6 +1,7 @@
-// The paper's arm as SPEC §5 tabulates it (standard DH, a_i = 0, θ_i = q_i; Table II with its
-// signs restored), written from the SPEC, not from models/: the tests and the benchmarks build
-// their reference robots from this one copy and check the shipped model files against it.
+// The paper's arm as its Table II tabulates it (standard DH, a_i = 0, θ_i = q_i; signs
+// restored), written from the paper, not from models/ or model/sample_models: the independent
+// copy against which the tests check the shipped model files and paper_arm(), and from which the
+// benchmarks build KDL's chain.
 #pragma once
 
 #include <numbers>

@@ -35,9 +35,9 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
                                   std::span<const ExternalWrench> external = {},
                                   bool with_gravity = true);
 
-/// What the robot discharges onto a base sensor at pose X_WS (SPEC 3: f_m = -f_0, n_m = -n_0
-/// about O_s), in the sensor frame: [f_m; n_m], moment about the sensor origin. Uses
-/// data.root_wrench_W from the last rnea.
+/// What the robot discharges onto a base sensor at pose X_WS (docs/method.md, "Newton-Euler and the
+/// base sensor": f_m = -f_0, n_m = -n_0 about O_s), in the sensor frame: [f_m; n_m], moment about
+/// the sensor origin. Uses data.root_wrench_W from the last rnea.
 [[nodiscard]] Vector6 sensor_reading(const Data& data, const Pose& X_WS);
 
 /// The same reading expressed in the world frame (moment still about O_s).

@@ -1,5 +1,5 @@
 // Intersection of a line of action with a link's collision geometry: places the contact point
-// on the surface (SPEC §4 C, eq. 21). See docs/geometry.md.
+// on the surface (the line of action (21), docs/method.md). See docs/geometry.md.
 //
 // The line is p(λ) = p₀ + λ u with u = d/‖d‖, λ ∈ R in metres along u. For a force F̂ applied by
 // a pusher, u = F̂/‖F̂‖ and the pusher comes from −u: the smallest λ on the surface is the
