@@ -7,6 +7,7 @@
 // finds every 100 ms.
 //
 //   example_estimator_loop [path/to/robot.urdf [K]]
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
