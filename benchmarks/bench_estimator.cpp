@@ -47,14 +47,15 @@ void BM_Residual_Ours(benchmark::State& state) {
   const PaperArm& arm = paper_arm();
   const Trajectory& tr = flange_trajectory();
   MomentumObserver observer(arm.model, kGain);
-  if (!observer.reset(0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok()) {
+  Data data(arm.model);
+  if (!observer.reset(arm.model, data, 0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok()) {
     state.SkipWithError("reset failed");
     return;
   }
   std::size_t k = 1;
   auto call = [&](std::size_t) {
     const std::size_t s = sample(k);
-    const Status st = observer.update(stamp(k, tr), tr.q[s], tr.dq[s], tr.tau[s]);
+    const Status st = observer.update(arm.model, data, stamp(k, tr), tr.q[s], tr.dq[s], tr.tau[s]);
     benchmark::DoNotOptimize(st);
     ++k;
   };

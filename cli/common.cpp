@@ -7,6 +7,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/io/number_text.hpp"
 
 namespace extwrench::cli {
@@ -64,19 +65,16 @@ Pose default_sensor_pose(const Model& model, std::string* description) {
   if (!frame) {
     if (description)
       *description = "the root link's origin ('" + model.bodies[0].name + "'), aligned with it";
-    return Pose::identity();
+  } else {
+    const Frame& f = model.frames[static_cast<std::size_t>(*frame)];
+    if (f.body != 0) {
+      throw Error("frame 'sensor' is attached to the moving body '" +
+                  model.bodies[static_cast<std::size_t>(f.body)].name +
+                  "', but a base sensor must be fixed to link 0; give --sensor-pose instead");
+    }
+    if (description) *description = "the model's frame 'sensor'";
   }
-  const Frame& f = model.frames[static_cast<std::size_t>(*frame)];
-  if (f.body != 0) {
-    throw Error("frame 'sensor' is attached to the moving body '" +
-                model.bodies[static_cast<std::size_t>(f.body)].name +
-                "', but a base sensor must be fixed to link 0; give --sensor-pose instead");
-  }
-  // Link 0 does not move: its pose at any q is its pose at q = 0.
-  Data data(model);
-  forward_kinematics(model, data, VectorX::Zero(model.nq()));
-  if (description) *description = "the model's frame 'sensor'";
-  return frame_pose(model, data, *frame);
+  return extwrench::default_sensor_pose(model);  // the library's rule (estimation/base_sensor)
 }
 
 std::string fmt(double value) {

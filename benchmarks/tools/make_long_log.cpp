@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
                      .truth = true,
                      .true_tau_ext = true};
     LogWriter writer(argv[2], layout);
-    sim::Sample s;
+    Sample s;
     s.q.resize(n);
     s.dq.resize(n);
     s.tau.resize(n);

@@ -293,7 +293,7 @@ FigureRecorder::FigureRecorder(const Model& model, bool truth, int max_points)
       row_(static_cast<std::size_t>(kQ + model.nq())),
       data_(model) {}
 
-void FigureRecorder::add(const sim::Sample& sample, const ContactEstimate& estimate) {
+void FigureRecorder::add(const Sample& sample, const ContactEstimate& estimate) {
   if (!rows_.wants_next()) {
     rows_.skip();
     return;
@@ -317,7 +317,7 @@ void FigureRecorder::estimate_columns(const ContactEstimate& e, double* r) const
   r[kCond] = e.condition_number;
 }
 
-void FigureRecorder::truth_columns(const sim::Sample& s, const ContactEstimate& e, double* r) {
+void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, double* r) {
   const bool touched = truth_ && s.truth.body >= 0;
   for (int k = 0; k < 3; ++k) {
     r[kFt + k] = truth_ ? (touched ? s.truth.force[k] : 0.0) : kNaN;

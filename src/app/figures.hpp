@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "extwrench/app/gnuplot.hpp"
+#include "extwrench/core/sample.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
-#include "extwrench/sim/sample.hpp"
 
 namespace extwrench::detail {
 
@@ -29,7 +29,7 @@ class FigureRecorder {
   FigureRecorder(const Model& model, bool truth, int max_points);
 
   /// One replayed sample and the estimate at it. Only kept rows are computed.
-  void add(const sim::Sample& sample, const ContactEstimate& estimate);
+  void add(const Sample& sample, const ContactEstimate& estimate);
 
   /// Writes the data and the five scripts, runs gnuplot on them; the PNGs in the order joints,
   /// force, line_point, condition, robot3d.
@@ -37,7 +37,7 @@ class FigureRecorder {
 
  private:
   void estimate_columns(const ContactEstimate& e, double* row) const;
-  void truth_columns(const sim::Sample& s, const ContactEstimate& e, double* row);
+  void truth_columns(const Sample& s, const ContactEstimate& e, double* row);
 
   const Model& model_;
   bool truth_;

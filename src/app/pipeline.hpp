@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/core/sample.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
 #include "extwrench/io/log.hpp"
-#include "extwrench/sim/sample.hpp"
 
 namespace extwrench::detail {
 
@@ -111,7 +111,7 @@ class BatchRing {
 /// every estimate pushed so far, then stops and joins both threads.
 class Pipeline {
  public:
-  Pipeline(LogReader& reader, EstimatesWriter& writer, const sim::Sample& sample_prototype,
+  Pipeline(LogReader& reader, EstimatesWriter& writer, const Sample& sample_prototype,
            const ContactEstimate& estimate_prototype)
       : in_(sample_prototype), out_(estimate_prototype) {
     reader_thread_ = std::thread([this, &reader] { read_rows(reader); });
@@ -131,7 +131,7 @@ class Pipeline {
 
   /// The next sample, valid until the following call; nullptr at the end of the log. Rethrows
   /// the reader's error (a malformed row) at its place in the sequence.
-  const sim::Sample* next() {
+  const Sample* next() {
     for (;;) {
       if (in_batch_ == nullptr) {
         in_batch_ = in_.acquire_full();  // the reader is only cancelled by our destructor
@@ -234,9 +234,9 @@ class Pipeline {
     reader_thread_.join();
   }
 
-  BatchRing<sim::Sample> in_;
+  BatchRing<Sample> in_;
   BatchRing<ContactEstimate> out_;
-  typename BatchRing<sim::Sample>::Batch* in_batch_ = nullptr;
+  typename BatchRing<Sample>::Batch* in_batch_ = nullptr;
   std::size_t in_index_ = 0;
   typename BatchRing<ContactEstimate>::Batch* out_batch_ = nullptr;
   std::exception_ptr write_error_;

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
-#include <memory>
 #include <optional>
 
 #include "extwrench/core/error.hpp"
@@ -41,30 +40,22 @@ void check_sensor_columns(const LogReader& reader, SensorType sensor) {
   }
 }
 
-// One estimator step on a sample, with or without its base reading.
-Status estimate_sample(ContactEstimator& estimator, const sim::Sample& s) {
-  return estimator.options().sensor.type == SensorType::kNone
-             ? estimator.update(s.t, s.q, s.dq, s.tau)
-             : estimator.update(s.t, s.q, s.dq, s.tau, s.sensor);
-}
-
 /// The estimate of each row. The first row (and each next one while the reset fails) resets the
 /// estimator: its estimate is "free" with a zero residual.
 class RowEstimator {
  public:
-  RowEstimator(std::unique_ptr<ContactEstimator> estimator, int n)
-      : estimator_(std::move(estimator)), n_(n) {
+  RowEstimator(ContactEstimator estimator, int n) : estimator_(std::move(estimator)), n_(n) {
     first_.residual = VectorX::Zero(n);
   }
   /// What every estimate looks like (sizes), for the pipeline's buffers.
   [[nodiscard]] const ContactEstimate& prototype() const { return first_; }
 
-  const ContactEstimate& update(const sim::Sample& s) {
+  const ContactEstimate& update(const Sample& s) {
     if (started_) {
-      (void)estimate_sample(*estimator_, s);  // the status is in the estimate's status column
-      return estimator_->result();
+      (void)estimator_.update(s);  // the status is in the estimate's status column
+      return estimator_.result();
     }
-    const Status st = estimator_->reset(s.t, s.q, s.dq, s.tau);
+    const Status st = estimator_.reset(s);
     first_ = ContactEstimate{};
     first_.t = s.t;
     first_.residual = VectorX::Zero(n_);
@@ -74,7 +65,7 @@ class RowEstimator {
   }
 
  private:
-  std::unique_ptr<ContactEstimator> estimator_;
+  ContactEstimator estimator_;
   int n_;
   bool started_ = false;
   ContactEstimate first_;
@@ -88,7 +79,7 @@ class WindowMetrics {
       windows_.push_back({"whole_log", "every sample of the log", sim::MetricsWindow{}});
     for (const auto& w : windows_) accumulators_.emplace_back(w.window);
   }
-  void add(const sim::Sample& s, const ContactEstimate& e) {
+  void add(const Sample& s, const ContactEstimate& e) {
     for (auto& acc : accumulators_) acc.add(s.t, s.truth, e);
   }
   [[nodiscard]] std::vector<NamedMetrics> result() const {
@@ -136,9 +127,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   if (o.warn_ignored_columns) note_ignored_columns(reader);
   check_sensor_columns(reader, estimator_options.sensor.type);
   std::filesystem::create_directories(o.out_dir);
-  RowEstimator estimator(std::make_unique<ContactEstimator>(model, geometry, estimator_options),
-                         model.nq());
-  EstimatesWriter writer(o.out_dir / "estimates.csv", model.nq());
+  RowEstimator estimator(ContactEstimator(model, geometry, estimator_options), model.nq());
+  EstimatesWriter writer(o.out_dir / "estimates.csv", model);
   WindowMetrics metrics(o.windows);
   std::optional<detail::FigureRecorder> figures;
   if (o.figures) figures.emplace(model, layout.truth, o.plot_points);
@@ -146,9 +136,9 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
   LogSpan span;
   const std::string log_name = reader.name();  // the reader belongs to its thread from here on
-  detail::Pipeline pipeline(reader, writer, sim::Sample{}, estimator.prototype());
-  while (const sim::Sample* sample = pipeline.next()) {
-    const sim::Sample& s = *sample;
+  detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype());
+  while (const Sample* sample = pipeline.next()) {
+    const Sample& s = *sample;
     const ContactEstimate& e = estimator.update(s);
     pipeline.push(e);
     span.add(s.t);

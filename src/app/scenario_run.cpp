@@ -52,12 +52,12 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   LogLayout layout;
   layout.n = model.nq();
   layout.velocity = s.log_velocity;
-  layout.force = sc.sensor.type != sim::BaseSensorType::kNone;
-  layout.moment = sc.sensor.type == sim::BaseSensorType::kForceTorque;
+  layout.force = sc.sensor.type != SensorType::kNone;
+  layout.moment = sc.sensor.type == SensorType::kForceTorque;
   layout.truth = true;
   layout.true_tau_ext = true;
   LogWriter log(r.dir / "log.csv", layout);
-  sim::Sample sample;
+  Sample sample;
   Data data(model);
   const long total = simulator.num_samples();
   const std::string label = "seed " + std::to_string(r.seed);

@@ -2,18 +2,6 @@
 
 namespace extwrench {
 
-std::string_view to_string(SensorType s) noexcept {
-  switch (s) {
-    case SensorType::kNone:
-      return "none";
-    case SensorType::kForce:
-      return "force";
-    case SensorType::kForceTorque:
-      return "ft";
-  }
-  return "unknown";
-}
-
 std::string_view to_string(ContactModel m) noexcept {
   switch (m) {
     case ContactModel::kPureForce:

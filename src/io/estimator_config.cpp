@@ -176,9 +176,9 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (root["payload"]) read_payload(rd, root["payload"], model, o);
   if (root["solver"]) read_solver(rd, root["solver"], o.solver);
 
-  // The remaining checks need the whole picture (serial chain, sizes): build once to be sure.
+  // The remaining checks need the whole picture (serial chain, sizes).
   try {
-    const ContactEstimator probe(model, cfg.robot.geometry, o);
+    validate(o, model);
   } catch (const Error& e) {
     throw Error(rd.file() + ": " + e.what());
   }
@@ -218,9 +218,8 @@ EstimatorConfig load_estimator_config_string(const std::string& yaml,
   return interpret(io_detail::load_yaml_string(yaml, name.string()), name, robot_options);
 }
 
-std::unique_ptr<ContactEstimator> make_estimator(const EstimatorConfig& config) {
-  return std::make_unique<ContactEstimator>(config.robot.model, config.robot.geometry,
-                                            config.options);
+ContactEstimator make_estimator(const EstimatorConfig& config) {
+  return ContactEstimator(config.robot.model, config.robot.geometry, config.options);
 }
 
 std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& directory) {

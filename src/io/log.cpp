@@ -112,7 +112,7 @@ void LogReader::read_vector(const std::vector<int>& columns, VectorX& v) const {
     v[static_cast<Eigen::Index>(i)] = csv_.number(columns[i]);
 }
 
-bool LogReader::read_row(sim::Sample& s) {
+bool LogReader::read_row(Sample& s) {
   if (!csv_.next_row()) return false;
   s.t = csv_.number(col_t_);
   if (have_prev_ && !(s.t > prev_t_)) {
@@ -133,7 +133,7 @@ bool LogReader::read_row(sim::Sample& s) {
   s.has_truth = layout_.truth;
   s.has_true_tau_ext = layout_.true_tau_ext;
   if (layout_.truth) {
-    sim::Truth& tr = s.truth;
+    Truth& tr = s.truth;
     const std::string_view link = csv_.cell(col_link_);
     if (link != last_link_) {
       // Resolve names only when they change (a log holds long runs of the same value).
@@ -178,7 +178,7 @@ bool LogReader::read_row(sim::Sample& s) {
   return true;
 }
 
-bool LogReader::next(sim::Sample& out) {
+bool LogReader::next(Sample& out) {
   if (pending_) {
     out = std::move(*pending_);
     pending_.reset();
@@ -190,7 +190,7 @@ bool LogReader::next(sim::Sample& out) {
   if (!layout_.velocity) {
     if (!have_prev_) {
       // First row: forward difference to the next row (zero if there is none).
-      sim::Sample next_sample;
+      Sample next_sample;
       prev_t_ = out.t;  // for the time check of the look-ahead row
       prev_line_ = sample_line_;
       have_prev_ = true;
@@ -218,7 +218,7 @@ bool LogReader::next(sim::Sample& out) {
 LogWriter::LogWriter(const std::filesystem::path& path, const LogLayout& layout)
     : layout_(layout), csv_(path, log_columns(layout)) {}
 
-void LogWriter::write(const sim::Sample& s) {
+void LogWriter::write(const Sample& s) {
   csv_.add(s.t);
   for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.q[i]);
   if (layout_.velocity)
@@ -255,8 +255,12 @@ std::vector<std::string> estimates_columns(int n) {
 }
 }  // namespace
 
-EstimatesWriter::EstimatesWriter(const std::filesystem::path& path, int n)
-    : n_(n), csv_(path, estimates_columns(n)), cached_status_(describe_flags(cached_flags_)) {}
+EstimatesWriter::EstimatesWriter(const std::filesystem::path& path, const Model& model)
+    : n_(model.nq()),
+      csv_(path, estimates_columns(model.nq())),
+      cached_status_(describe_flags(cached_flags_)) {
+  for (const Body& b : model.bodies) body_names_.push_back(b.name);
+}
 
 std::string EstimatesWriter::status_text(const ContactEstimate& e) {
   if (!e.status.ok()) {
@@ -277,7 +281,9 @@ std::string EstimatesWriter::status_text(const ContactEstimate& e) {
 void EstimatesWriter::write(const ContactEstimate& e) {
   csv_.add(e.t);
   csv_.add(e.contact ? 1 : 0);
-  csv_.add(e.contact ? e.link_name : std::string_view());
+  const bool named = e.contact && e.link >= 0 && e.link < static_cast<int>(body_names_.size());
+  csv_.add(named ? std::string_view(body_names_[static_cast<std::size_t>(e.link)])
+                 : std::string_view());
   for (int k = 0; k < 3; ++k) csv_.add(e.force_W[k]);
   for (int k = 0; k < 3; ++k) csv_.add(e.moment_W[k]);
   for (int k = 0; k < 3; ++k) csv_.add(e.point_W[k]);

@@ -67,21 +67,8 @@ sim::ForceProfile parse_force(const YamlReader& y, const YAML::Node& node, const
 // The simulated base sensor; its pose defaults to the robot's frame 'sensor' on link 0.
 void parse_base_sensor(const YamlReader& y, const YAML::Node& b, sim::BaseSensorModel& base) {
   y.only_keys(b, "sensors.base", {"type", "pose", "bias", "force_noise", "moment_noise"});
-  if (b["type"]) {
-    // (until sim uses SensorType itself)
-    switch (y.sensor_type(b["type"], "sensors.base.type")) {
-      case SensorType::kForceTorque:
-        base.type = sim::BaseSensorType::kForceTorque;
-        break;
-      case SensorType::kForce:
-        base.type = sim::BaseSensorType::kForce;
-        break;
-      case SensorType::kNone:
-        base.type = sim::BaseSensorType::kNone;
-        break;
-    }
-  }
-  if (b["pose"]) base.X_RS = y.pose(b["pose"], "sensors.base.pose");
+  if (b["type"]) base.type = y.sensor_type(b["type"], "sensors.base.type");
+  if (b["pose"]) base.X_WS = y.pose(b["pose"], "sensors.base.pose");
   if (b["bias"]) base.bias = y.vector(b["bias"], "sensors.base.bias", 6);
   if (b["force_noise"])
     base.force_noise = y.vector(b["force_noise"], "sensors.base.force_noise", 3);
@@ -105,12 +92,8 @@ void parse_encoder(const YamlReader& y, const YAML::Node& e, sim::EncoderModel& 
 void parse_sensors(const YamlReader& y, const YAML::Node& node, Scenario& s) {
   y.only_keys(node, "sensors", {"base", "encoder", "log_velocity"});
   sim::BaseSensorModel& base = s.simulation.sensor;
-  base.type = sim::BaseSensorType::kForceTorque;
-  base.X_RS = Pose::identity();
-  if (const auto sf = s.robot.model.find_frame("sensor")) {
-    const Frame& f = s.robot.model.frames[static_cast<std::size_t>(*sf)];
-    if (f.body == 0) base.X_RS = f.placement;
-  }
+  base.type = SensorType::kForceTorque;
+  base.X_WS = default_sensor_pose(s.robot.model);  // a "sensor" frame on a moving body: identity
   if (const YAML::Node b = node["base"]) parse_base_sensor(y, b, base);
   if (const YAML::Node e = node["encoder"]) parse_encoder(y, e, s.simulation.encoder);
   if (node["log_velocity"])
@@ -309,7 +292,7 @@ std::string scheme_config_yaml(const Scenario& s, const SchemeSpec& scheme) {
                               format_number(g.z()) + "]");
   for (const auto& kv : node) out[kv.first.Scalar()] = kv.second;
   if (out["sensor"]["type"].Scalar() != "none" && !out["sensor"]["pose"]) {
-    out["sensor"]["pose"] = YAML::Load(pose_yaml(s.simulation.sensor.X_RS));
+    out["sensor"]["pose"] = YAML::Load(pose_yaml(s.simulation.sensor.X_WS));
   }
   YAML::Emitter e;
   e << out;

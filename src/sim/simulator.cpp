@@ -116,10 +116,10 @@ bool Simulator::next(Sample& out) {
   }
   const VectorX ddq = ws_.data.ddq;
   rnea(model_, ws_.data, q_, dq_, ddq, ws_.wrenches);
-  const Vector6 ideal = sensor_reading(ws_.data, config_.sensor.X_RS);
+  const Vector6 ideal = sensor_reading(ws_.data, config_.sensor.X_WS);
   out.sensor = config_.sensor.measure(ideal, noise_);
-  out.has_force = config_.sensor.type != BaseSensorType::kNone;
-  out.has_moment = config_.sensor.type == BaseSensorType::kForceTorque;
+  out.has_force = config_.sensor.type != SensorType::kNone;
+  out.has_moment = config_.sensor.type == SensorType::kForceTorque;
   if (!out.has_force) out.sensor.setZero();
   if (!out.has_moment) out.sensor.tail<3>().setZero();
 

@@ -110,10 +110,10 @@ TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
 
 TEST(EstimatorConfig, MakesAWorkingEstimator) {
   const EstimatorConfig c = load_estimator_config(kDir / "paper_ft.yaml");
-  const std::unique_ptr<ContactEstimator> est = make_estimator(c);
+  ContactEstimator est = make_estimator(c);
   const VectorX z = VectorX::Zero(7);
-  ASSERT_TRUE(est->reset(0.0, z, z, z).ok());
-  EXPECT_TRUE(est->update(1e-3, z, z, z, Vector6::Zero()).ok());
+  ASSERT_TRUE(est.reset(0.0, z, z, z).ok());
+  EXPECT_TRUE(est.update(1e-3, z, z, z, Vector6::Zero()).ok());
 }
 
 struct BadConfig {

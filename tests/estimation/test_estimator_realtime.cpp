@@ -309,5 +309,102 @@ TEST(EstimatorRealTime, RejectsOptionsThatDoNotFitTheModel) {
   }
 }
 
+TEST(EstimatorRealTime, PayloadEditsTheEstimatorsOwnModelContinuouslyAndRejectsBadInput) {
+  const Model model = test::paper_arm_model();
+  ContactEstimator est(model, {}, EstimatorOptions{});
+  SeededRng rng(17);
+  const VectorX q = rng.uniform_vector(7, -1, 1), dq = rng.uniform_vector(7, -0.5, 0.5),
+                tau = rng.uniform_vector(7, -5, 5);
+  ASSERT_TRUE(est.reset(0.0, q, dq, tau).ok());
+  ASSERT_TRUE(est.update(1e-3, q, dq, tau).ok());
+  const VectorX r = est.observer().residual();
+  Inertia payload;
+  payload.mass = 1.5;
+  payload.com = Vector3(0.01, -0.02, 0.12);
+  payload.inertia_com = Vector3(0.004, 0.005, 0.003).asDiagonal();
+  {
+    test::AllocationCounter counter;
+    ASSERT_TRUE(est.set_payload(7, payload).ok());
+    if (test::allocation_counting_available()) {
+      EXPECT_EQ(counter.count(), 0u);
+    }
+  }
+  EXPECT_TRUE(est.observer().residual() == r);  // the edit itself does not move r
+  EXPECT_EQ(est.model().bodies[7].inertia.mass, model.bodies[7].inertia.mass + 1.5);
+  EXPECT_EQ(model.bodies[7].inertia.mass, test::paper_arm_model().bodies[7].inertia.mass);
+  EXPECT_EQ(est.set_payload(9, payload).code, StatusCode::kWrongSize);
+  Inertia bad = payload;
+  bad.mass = kNaN;
+  EXPECT_EQ(est.set_payload(3, bad).code, StatusCode::kNonFinite);
+  EXPECT_EQ(est.model().bodies[7].inertia.mass, model.bodies[7].inertia.mass + 1.5);
+  est.clear_payload();
+  EXPECT_EQ(est.model().bodies[7].inertia.mass, model.bodies[7].inertia.mass);
+}
+
+TEST(EstimatorRealTime, EstimatorIsAValueThatCopiesAndMovesWithItsState) {
+  const Samples s = make_samples(40, 5, 31);
+  const Model model = test::paper_arm_model();
+  EstimatorOptions o;
+  o.sensor.type = SensorType::kForceTorque;
+  ContactEstimator a(model, test::paper_arm_capsules(model), o);
+  ASSERT_TRUE(a.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+  for (int k = 1; k < 20; ++k)
+    ASSERT_TRUE(a.update(k * 1e-3, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+  ContactEstimator b = a;  // a copy continues exactly as the original
+  ContactEstimator c(std::move(b));
+  for (int k = 20; k < 40; ++k) {
+    ASSERT_TRUE(a.update(k * 1e-3, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+    ASSERT_TRUE(c.update(k * 1e-3, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+    ASSERT_TRUE(a.result().residual == c.result().residual) << "sample " << k;
+    ASSERT_EQ(std::memcmp(a.result().force_W.data(), c.result().force_W.data(), sizeof(Vector3)),
+              0);
+    ASSERT_EQ(a.result().flags, c.result().flags);
+  }
+}
+
+TEST(EstimatorRealTime, UpdateFromASampleServesEverySensorTypeBitForBitWithoutAllocation) {
+  const Samples s = make_samples(60, 7, 5);
+  const Model model = test::paper_arm_model();
+  for (const Config& c : all_configs()) {
+    ContactEstimator direct(model, test::paper_arm_capsules(model), options_for(c));
+    ContactEstimator from_sample = direct;
+    Sample sample;
+    sample.t = 0.0;
+    sample.q = s.q[0];
+    sample.dq = s.dq[0];
+    sample.tau = s.tau[0];
+    ASSERT_TRUE(direct.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    ASSERT_TRUE(from_sample.reset(sample).ok());
+    for (int k = 1; k < 60; ++k) {
+      const double t = k * 1e-3;
+      const Status st = c.sensor == SensorType::kNone
+                            ? direct.update(t, s.q[k], s.dq[k], s.tau[k])
+                            : direct.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]);
+      sample.t = t;
+      sample.q = s.q[k];
+      sample.dq = s.dq[k];
+      sample.tau = s.tau[k];
+      sample.sensor = s.reading[k];
+      if (c.sensor != SensorType::kNone && k % 7 == 0) {
+        // A sample without the reading the sensor needs: rejected, nothing changed.
+        sample.has_force = c.sensor == SensorType::kForceTorque;
+        sample.has_moment = false;
+        const Status missing = from_sample.update(sample);
+        EXPECT_EQ(missing.code, StatusCode::kWrongSize) << describe(c);
+        EXPECT_EQ(missing.channel, Channel::kBaseWrench) << describe(c);
+      }
+      sample.has_force = c.sensor != SensorType::kNone;
+      sample.has_moment = c.sensor == SensorType::kForceTorque;
+      test::AllocationCounter counter;
+      const Status via_sample = from_sample.update(sample);
+      if (test::allocation_counting_available()) {
+        EXPECT_EQ(counter.count(), 0u) << describe(c);
+      }
+      ASSERT_EQ(st.code, via_sample.code) << describe(c);
+      ASSERT_TRUE(same_bits(direct.result(), from_sample.result())) << describe(c) << " " << k;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace extwrench

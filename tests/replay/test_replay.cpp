@@ -75,8 +75,8 @@ class Replay : public ::testing::Test {
 };
 RobotDescription* Replay::robot_ = nullptr;
 
-sim::Sample random_sample(test::SeededRng& rng, double t, int n) {
-  sim::Sample s;
+Sample random_sample(test::SeededRng& rng, double t, int n) {
+  Sample s;
   s.t = t;
   s.q = rng.uniform_vector(n, -2, 2);
   s.dq = rng.uniform_vector(n, -1, 1);
@@ -99,13 +99,13 @@ TEST_F(Replay, LogWrittenThenReadGivesBackEveryNumberBitForBit) {
   LogLayout layout{
       .n = 7, .velocity = true, .force = true, .moment = true, .truth = true, .true_tau_ext = true};
   test::SeededRng rng(3);
-  std::vector<sim::Sample> written;
+  std::vector<Sample> written;
   {
     LogWriter w(dir / "log.csv", layout);
     for (int k = 0; k < 50; ++k) {
       written.push_back(random_sample(rng, 0.001 * k + 1e-17 * k, 7));
       if (k % 7 == 3) {  // a free sample
-        written.back().truth = sim::Truth{};
+        written.back().truth = Truth{};
         written.back().truth.tau_ext = VectorX::Zero(7);
       }
       w.write(written.back());
@@ -114,8 +114,8 @@ TEST_F(Replay, LogWrittenThenReadGivesBackEveryNumberBitForBit) {
   }
   LogReader r(dir / "log.csv", robot_->model);
   EXPECT_TRUE(r.ignored_columns().empty());
-  sim::Sample s;
-  for (const sim::Sample& e : written) {
+  Sample s;
+  for (const Sample& e : written) {
     ASSERT_TRUE(r.next(s));
     EXPECT_EQ(s.t, e.t);
     EXPECT_EQ(s.q, e.q);
@@ -147,7 +147,7 @@ TEST_F(Replay, LogWithoutVelocitiesIsDifferentiated) {
   LogReader r(dir / "log.csv", robot_->model);
   ASSERT_EQ(r.ignored_columns(), std::vector<std::string>{"extra"});
   EXPECT_FALSE(r.layout().velocity);
-  sim::Sample s;
+  Sample s;
   std::vector<double> dq1;
   while (r.next(s)) dq1.push_back(s.dq[0]);
   ASSERT_EQ(dq1.size(), 4u);
@@ -220,7 +220,7 @@ TEST_F(Replay, MalformedLogsAreErrorsNamingLineAndColumn) {
     write_file(path, c.text);
     const std::string what = error_of([&] {
       LogReader r(path, robot_->model);
-      sim::Sample s;
+      Sample s;
       while (r.next(s)) {
       }
     });
@@ -471,7 +471,7 @@ void write_synthetic_log(const fs::path& path, long rows) {
   LogLayout layout{
       .n = 7, .velocity = true, .force = true, .moment = true, .truth = true, .true_tau_ext = true};
   LogWriter w(path, layout);
-  sim::Sample s;
+  Sample s;
   s.q.resize(7);
   s.dq.resize(7);
   s.tau.resize(7);

@@ -72,7 +72,7 @@ void write_log(const fs::path& path, long rows, bool velocity) {
                    .true_tau_ext = false};
   LogWriter w(path, layout);
   test::SeededRng rng(11);
-  sim::Sample s;
+  Sample s;
   s.q.resize(7);
   s.dq.resize(7);
   s.tau.resize(7);
@@ -136,8 +136,8 @@ Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& option
     LogReader reader(log, robot.model);
     ContactEstimator estimator(robot.model, robot.geometry, options);
     const int n = robot.model.nq();
-    EstimatesWriter writer(out_dir / "estimates.csv", n);
-    sim::Sample s;
+    EstimatesWriter writer(out_dir / "estimates.csv", robot.model);
+    Sample s;
     bool started = false;
     while (reader.next(s)) {
       if (!started) {

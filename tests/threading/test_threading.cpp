@@ -103,14 +103,17 @@ TEST(Threading, DynamicsOnASharedConstModelMatchSingleThreadedBitForBit) {
 }
 
 TEST(Threading, OneMomentumObserverPerThreadMatchesSingleThreadedBitForBit) {
-  const Model& model = paper_arm().model;  // each observer copies it; the original stays shared
+  const Model& model = paper_arm().model;  // shared, read-only; each thread owns its Data
   const States s = seeded_states(model.nq(), 3000, 12);
   auto work = [&] {
     MomentumObserver observer(model, 100.0);
+    Data data(model);
     std::vector<double> out;
-    EXPECT_TRUE(observer.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    EXPECT_TRUE(observer.reset(model, data, 0.0, s.q[0], s.dq[0], s.tau[0]).ok());
     for (std::size_t k = 1; k < s.q.size(); ++k) {
-      EXPECT_TRUE(observer.update(static_cast<double>(k) * 1e-3, s.q[k], s.dq[k], s.tau[k]).ok());
+      EXPECT_TRUE(
+          observer.update(model, data, static_cast<double>(k) * 1e-3, s.q[k], s.dq[k], s.tau[k])
+              .ok());
       append(out, observer.residual());
     }
     return out;

@@ -1,4 +1,5 @@
-// The configuration enums of the estimators and their per-sample output.
+// The configuration enums of the estimators and their per-sample output (SensorType, the Table I
+// columns, is in base_sensor.hpp).
 #pragma once
 
 #include <cstdint>
@@ -10,13 +11,6 @@
 #include "extwrench/core/types.hpp"
 
 namespace extwrench {
-
-/// Base sensor (Table I columns).
-enum class SensorType : std::uint8_t {
-  kNone,         ///< no base sensor: joint torques only (case E)
-  kForce,        ///< 3-axis force sensor (cases A, D)
-  kForceTorque,  ///< 6-axis F/T sensor (cases A, B, C)
-};
 
 /// Contact assumption (Table I rows).
 enum class ContactModel : std::uint8_t {
@@ -30,7 +24,6 @@ enum class AccelerationRoute : std::uint8_t {
   kDifferentiation,  ///< (a) q̈̂ = low-passed difference of q̇, τ̂_ext = RNEA(q, q̇, q̈̂) + τ_f − τ
 };
 
-[[nodiscard]] std::string_view to_string(SensorType s) noexcept;
 [[nodiscard]] std::string_view to_string(ContactModel m) noexcept;
 [[nodiscard]] std::string_view to_string(AccelerationRoute a) noexcept;
 
@@ -73,8 +66,8 @@ struct ContactEstimate {
 
   double t = kNaN;       ///< time stamp of the sample [s]
   bool contact = false;  ///< a contact is declared (detection with hysteresis and min_duration)
-  int link = -1;         ///< contact link (body index, 0 = link 0); −1 when none
-  std::string_view link_name;  ///< name of that body (views the estimator's model); empty when none
+  int link =
+      -1;  ///< contact link (body index, 0 = link 0; name: model.bodies[link].name); −1 if none
   Vector3 force_W = Vector3::Constant(kNaN);  ///< F̂_ext [N]
   Vector3 moment_W = Vector3::Constant(
       kNaN);  ///< M̂_ext [N m], pure moment besides the force at the point (known point)

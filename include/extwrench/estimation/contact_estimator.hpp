@@ -1,93 +1,58 @@
-// One estimator over all of Table I (SPEC §4): from q, q̇, τ and, when present, a base sensor,
-// say whether the robot is touched, on which link, with what force and moment, and where.
+// One estimator over all of Table I (docs/estimator.md): from q, q̇, τ and, when present, a base
+// sensor, say whether the robot is touched, on which link, with what force and moment, and where.
 //
-// Per sample (update): the momentum residual (observer) → q̈̂ and τ̂_ext (route (a) or (b)) → the
-// no-contact ground wrench (f̃_g, ñ_g) from one RNEA pass → the sensor reading minus its bias,
-// rotated into W → detection and isolation → the case of Table I:
-//   A  F̂ = f_m − f̃_g                                  (11)   force or F/T sensor, any link
-//   B  M̂ = n_m − ñ_g − r_{s,p} × F̂                    (16)   F/T, known point
-//   C  M̃ = n_m − r_{s,l} × F̂ − ñ_g,  r̂ = F̂ × M̃/‖F̂‖²  (17–20) F/T, pure force
-//   D  M̄̂ = (J_ω,lᵀ)# (τ̂_1:l − J_v,lᵀ F̂)               (26)   force sensor, rank J_ω,l = 3
-//   E  W̄ = (J_lᵀ)# τ̂_1:l                              (27)   no sensor, rank J_l = 6
-// then the line of action p̂ + λ F̂/‖F̂‖ (21) meets the link's collision shapes: the smallest λ is
-// the pushing point. O_l is the origin of body l's frame, J_l the Jacobian of that point.
-//
-// Damped least squares (Remark 6) for D and E. With σ_1 ≥ … ≥ σ_min the singular values of J
-// (3×l or 6×l) and ε = σ_1 / max_condition:
-//   μ² = 0 if σ_min ≥ ε,   μ² = ε² − σ_min² otherwise,   x = (J Jᵀ + μ² I)⁻¹ J b,
-// so the solution is exact up to the condition number max_condition, the damping grows smoothly
-// as σ_min falls below ε, and the gain along the weakest direction stays ≤ 1/ε (bounded output).
-// Observability is a rank test: σ_min ≤ rank_tolerance · σ_1 means the moment / point (D) or the
-// wrench (E) cannot be estimated at this configuration (kUnobservable, NaN), whatever the link.
+// The estimator owns its Model (payloads edit it), its Data, the collision geometry, the
+// momentum observer's state and the detector: it is a value (copy and move freely). update()
+// runs these stages in the order a sample flows, each reading what the one before left:
+//   1. momentum and bias terms   dynamics pass on data_ (momentum.hpp)
+//   2. observer integration      r ≈ τ_ext (momentum_observer.hpp, eq. 4)
+//   3. acceleration route        q̈̂ by route (a) or (b)
+//   4. ground wrench             (f̃_g, ñ_g), the no-contact base wrench, and the route's τ̂_ext
+//   5. base-sensor reading       tare, F̂_ext (11), n_m − ñ_g (13)       (base_sensor.hpp)
+//   6. detection                 thresholds, hysteresis, min_duration     (detection.hpp)
+//   7. isolation                 the contact link                         (detection.hpp)
+//   8. Table I case              (F̂, M̄) by case A–E, known point (16)   (wrench_cases.hpp)
+//   9. contact point             line of action (21) → link surface       (localization.hpp)
+// then the consistency of the wrench with τ̂_ext (wrench_cases.hpp). Damped least squares
+// (Remark 6) for D and E: damped_least_squares.hpp.
 //
 // Real time: update() is noexcept, allocation-free, and validates every input before touching
 // any state (bad inputs: a Status naming the channel and index; the next good sample gives
 // bit-identical results to a run that never saw the bad one).
 #pragma once
 
-#include <Eigen/Cholesky>
-#include <optional>
+#include <vector>
 
-#include "extwrench/estimation/contact_detector.hpp"
+#include "extwrench/core/sample.hpp"
+#include "extwrench/dynamics/data.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
+#include "extwrench/estimation/detection.hpp"
+#include "extwrench/estimation/estimator_options.hpp"
+#include "extwrench/estimation/wrench_cases.hpp"
 #include "extwrench/geometry/shapes.hpp"
 #include "extwrench/observer/momentum_observer.hpp"
 
 namespace extwrench {
 
-struct SensorOptions {
-  SensorType type = SensorType::kNone;
-  Pose pose;  ///< X_WS: pose of the sensor frame in the robot's root frame
-  int tare_samples =
-      0;  ///< > 0: bias = mean(reading − predicted) over the first samples after reset
-};
-
-struct ContactOptions {
-  ContactModel model = ContactModel::kPureForce;
-  int link = -1;                    ///< known point: body index of the contact link
-  Vector3 point = Vector3::Zero();  ///< known point: p in the link frame [m]
-};
-
-struct PayloadOptions {
-  int body = -1;    ///< body carrying the payload
-  Inertia inertia;  ///< mass properties in that body's frame
-};
-
-struct SolverOptions {
-  double max_condition = 1e3;  ///< κ above which damping starts (damped least squares)
-  /// σ_min/σ_max at or below which the rank is deficient. σ comes from the eigenvalues of J Jᵀ,
-  /// accurate to ~1e-8 σ_max, so the tolerance must stay well above that.
-  double rank_tolerance = 1e-6;
-};
-
-struct EstimatorOptions {
-  SensorOptions sensor;
-  ContactOptions contact;
-  VectorX observer_gain = VectorX::Constant(1, 100.0);  ///< K [1/s], size 1 or n
-  DetectionOptions detection;
-  AccelerationRoute acceleration = AccelerationRoute::kResidual;
-  double differentiation_cutoff = 50.0;   ///< [Hz] low-pass of the differentiated q̇ (route (a))
-  std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction
-  std::optional<PayloadOptions> payload;
-  SolverOptions solver;
-};
-
 class ContactEstimator {
  public:
   /// Copies the model and geometry (the estimator owns what it uses). Throws extwrench::Error if
-  /// the options do not fit the model (sizes, link indices, ranges) or the model is not a serial
-  /// chain (isolation by joint index needs one).
+  /// the options do not fit the model (validate(options, model)) or the geometry has another
+  /// number of bodies than the model.
   ContactEstimator(Model model, GeometryModel geometry, EstimatorOptions options);
-  // result().link_name views the owned model: neither copied nor moved (hold it by unique_ptr).
-  ContactEstimator(const ContactEstimator&) = delete;
-  ContactEstimator& operator=(const ContactEstimator&) = delete;
 
   /// Starts at time t (observer reset, filters and detection cleared, tare restarted if
   /// configured). τ is the torque held over the first interval.
   [[nodiscard]] Status reset(double t, const Eigen::Ref<const VectorX>& q,
                              const Eigen::Ref<const VectorX>& dq,
                              const Eigen::Ref<const VectorX>& tau) noexcept;
+  /// reset(s.t, s.q, s.dq, s.tau).
+  [[nodiscard]] Status reset(const Sample& s) noexcept { return reset(s.t, s.q, s.dq, s.tau); }
 
+  /// One sample of any sensor type: the base reading s.sensor is used when the configured sensor
+  /// needs it, and must then be present (s.has_force, and s.has_moment for an F/T sensor; else
+  /// kWrongSize on the base-wrench channel). Returns result().status.
+  [[nodiscard]] Status update(const Sample& s) noexcept;
   /// One sample with a base reading [f; n] in the sensor frame (moment about the sensor origin;
   /// a 3-axis sensor uses the first three entries only). Returns result().status.
   [[nodiscard]] Status update(double t, const Eigen::Ref<const VectorX>& q,
@@ -109,17 +74,24 @@ class ContactEstimator {
                                    const Vector6& reading_S) noexcept;
 
   /// Re-estimates the sensor bias over the next `samples` samples (robot free of contact).
-  void request_tare(int samples) noexcept;
+  void request_tare(int samples) noexcept { tare_.request(samples); }
   /// Sensor bias [f; n] in the sensor frame (subtracted from every reading).
-  [[nodiscard]] const Vector6& sensor_bias() const noexcept { return bias_S_; }
-  void set_sensor_bias(const Vector6& bias_S) noexcept { bias_S_ = bias_S; }
+  [[nodiscard]] const Vector6& sensor_bias() const noexcept { return tare_.bias_S; }
+  void set_sensor_bias(const Vector6& bias_S) noexcept { tare_.bias_S = bias_S; }
 
-  /// Payload on a body, at run time (see MomentumObserver::set_payload).
+  /// Adds a payload (mass properties in the frame of `body`) to body `body` of model(),
+  /// replacing any previous payload; the observer is re-anchored so that r stays continuous.
+  /// Allocation-free. kWrongSize for a bad body index, kNonFinite for a NaN/Inf entry or a
+  /// negative mass (then nothing changes).
   [[nodiscard]] Status set_payload(int body, const Inertia& payload) noexcept;
-  void clear_payload() noexcept { observer_.clear_payload(); }
+  /// Removes the payload (same continuity as set_payload).
+  void clear_payload() noexcept { apply_payload(-1, nullptr); }
 
   [[nodiscard]] const ContactEstimate& result() const noexcept { return out_; }
-  [[nodiscard]] const Model& model() const noexcept { return observer_.model(); }
+  /// The model in use (payload included); body names: model().bodies[result().link].name.
+  [[nodiscard]] const Model& model() const noexcept { return model_; }
+  /// The dynamics workspace after the last sample (poses X_WB of its q, among others).
+  [[nodiscard]] const Data& data() const noexcept { return data_; }
   [[nodiscard]] const GeometryModel& geometry() const noexcept { return geometry_; }
   [[nodiscard]] const EstimatorOptions& options() const noexcept { return options_; }
   [[nodiscard]] const MomentumObserver& observer() const noexcept { return observer_; }
@@ -128,35 +100,48 @@ class ContactEstimator {
   [[nodiscard]] const VectorX& acceleration() const noexcept { return ddq_; }
 
  private:
-  Status validate_reading(const Vector6& reading_S) const noexcept;
-  Status validate_common(double t, const Eigen::Ref<const VectorX>& q,
+  // Stages of update(), in order (see the header comment).
+  void momentum_and_bias_terms_stage(const Eigen::Ref<const VectorX>& q,
+                                     const Eigen::Ref<const VectorX>& dq) noexcept;
+  Status acceleration_route(double dt, const Eigen::Ref<const VectorX>& dq,
+                            const Eigen::Ref<const VectorX>& tau) noexcept;
+  void ground_wrench(const Eigen::Ref<const VectorX>& dq) noexcept;
+  void estimate(double t, const Vector6& reading_S) noexcept;  // stages 5–9
+  BaseWrench base_sensor_reading(const Vector6& reading_S, std::uint32_t& flags) noexcept;
+  WrenchFit table_one_case(int link, const BaseWrench& base, std::uint32_t& flags) noexcept;
+  void contact_point(int link, const WrenchFit& fit, bool contact, std::uint32_t& flags) noexcept;
+  void consistency(double t, int link, bool contact, const WrenchFit& fit,
+                   std::uint32_t& flags) noexcept;
+
+  Status validate_sample(double t, const Eigen::Ref<const VectorX>& q,
                          const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau,
                          const Vector6& reading_S) const noexcept;
   void fail(double t, Status s) noexcept;
-  void estimate(double t, const Vector6& reading_S) noexcept;
-  void locate_on_surface(int link) noexcept;
+  void begin_output(double t) noexcept;
+  void apply_payload(int body, const Inertia* payload) noexcept;
 
   EstimatorOptions options_;
+  Model model_;
+  std::vector<Inertia> nominal_inertia_;  ///< bodies' inertia without payload
+  int payload_body_ = -1;
+  Data data_;
   GeometryModel geometry_;
   MomentumObserver observer_;
   ContactDetector detector_;
   int n_ = 0;
-  double settle_time_ = 0.0;  ///< residual / filter transient (5 time constants) [s]
+  bool differentiation_ = false;  ///< route (a)
+  bool need_ddq_ = false;         ///< q̈̂ needed: a sensor, or route (a)
+  double settle_time_ = 0.0;      ///< residual / filter transient (5 time constants) [s]
 
   // State besides the observer's.
   bool initialized_ = false;
   double t_ = 0.0;
   VectorX dq_prev_, ddq_filtered_;  ///< route (a)
   bool have_dq_prev_ = false;
-  Vector6 bias_S_ = Vector6::Zero();
-  Vector6 tare_sum_ = Vector6::Zero();
-  int tare_count_ = 0, tare_target_ = 0;
+  SensorTare tare_;
   bool disagreement_on_ = false, have_disagreement_edge_ = false;
   double disagreement_edge_ = 0.0;
-  // Extreme eigenvectors of J Jᵀ at the last sample (cases D, E): where the next sample's
-  // power / inverse iterations start. spectrum_size_ = 3 or 6 when valid, 0 after reset.
-  Vector6 spectrum_min_ = Vector6::Zero(), spectrum_max_ = Vector6::Zero();
-  int spectrum_size_ = 0;
+  SpectrumGuess spectrum_;  ///< of J Jᵀ at the last damped solve (cases D, E); size 0 after reset
 
   // Scratch, sized once.
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;

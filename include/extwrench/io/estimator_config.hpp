@@ -49,7 +49,7 @@ struct EstimatorConfig {
                                                            const LoadOptions& robot_options = {});
 
 /// The configured estimator (model and collision geometry copied from config.robot).
-[[nodiscard]] std::unique_ptr<ContactEstimator> make_estimator(const EstimatorConfig& config);
+[[nodiscard]] ContactEstimator make_estimator(const EstimatorConfig& config);
 
 /// The options written back as a configuration file (robot path as given, made relative to
 /// `directory` when possible). Loading the result gives the same options.

@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "extwrench/core/sample.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
 #include "extwrench/io/csv.hpp"
 #include "extwrench/model/model.hpp"
-#include "extwrench/sim/sample.hpp"
 
 namespace extwrench {
 
@@ -46,10 +46,10 @@ class LogReader {
   [[nodiscard]] std::size_t line() const { return sample_line_; }
 
   /// Next row into `out` (vectors sized once, then reused). False at the end of the file.
-  bool next(sim::Sample& out);
+  bool next(Sample& out);
 
  private:
-  bool read_row(sim::Sample& out);  // parses the current CSV row
+  bool read_row(Sample& out);  // parses the current CSV row
   void read_vector(const std::vector<int>& columns, VectorX& v) const;
 
   CsvReader csv_;
@@ -65,7 +65,7 @@ class LogReader {
   std::size_t prev_line_ = 0;
   VectorX prev_q_;
   // One row of look-ahead, used for the first row's velocity when dq is not logged.
-  std::optional<sim::Sample> pending_;
+  std::optional<Sample> pending_;
   std::size_t pending_line_ = 0;
   std::size_t sample_line_ = 0;
   std::string last_link_;
@@ -77,7 +77,7 @@ class LogReader {
 class LogWriter {
  public:
   LogWriter(const std::filesystem::path& path, const LogLayout& layout);
-  void write(const sim::Sample& s);
+  void write(const Sample& s);
   void close() { csv_.close(); }
 
  private:
@@ -89,7 +89,8 @@ class LogWriter {
 /// r1..rn (world frame; quantities not estimated are empty cells; round-trip precision).
 class EstimatesWriter {
  public:
-  EstimatesWriter(const std::filesystem::path& path, int n);
+  /// `model` gives n and the body names of the link column.
+  EstimatesWriter(const std::filesystem::path& path, const Model& model);
   void write(const ContactEstimate& e);
   void close() { csv_.close(); }
 
@@ -99,6 +100,7 @@ class EstimatesWriter {
 
  private:
   int n_;
+  std::vector<std::string> body_names_;
   CsvWriter csv_;
   // The status text of the last ok row: flags change rarely, describe_flags() allocates.
   std::uint32_t cached_flags_ = 0;

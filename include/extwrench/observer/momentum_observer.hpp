@@ -17,9 +17,11 @@
 // digital controller applies it: τ_k acts on [t_k, t_{k+1})); the state-dependent terms γ use the
 // trapezoidal rule. For a constant τ_ext starting at a sample, r_k = (1 − e^{−K (t_k − t_0)}) τ_ext
 // up to the trapezoidal error of γ (O(Δt²)).
+//
+// The observer is state only, in the (model, data) style of the dynamics functions: the caller
+// owns the Model and the Data and passes them to each call (the ContactEstimator passes its own,
+// payload included). Every member is a value: the observer copies and moves freely.
 #pragma once
-
-#include <memory>
 
 #include "extwrench/core/status.hpp"
 #include "extwrench/dynamics/data.hpp"
@@ -29,38 +31,39 @@ namespace extwrench {
 
 class MomentumObserver {
  public:
-  /// Keeps its own copy of `model` (payload changes edit that copy, never the caller's) and
-  /// sizes every buffer once. `gains`: K_i > 0 [1/s], size n, or size 1 for the same K on every
-  /// joint. Friction defaults to the model's Joint::damping / Joint::friction.
-  /// Throws extwrench::Error on a bad gain or an empty model.
-  MomentumObserver(Model model, const VectorX& gains);
-  MomentumObserver(Model model, double gain);
+  /// Sizes every buffer once for `model`'s n joints. `gains`: K_i > 0 [1/s], size n, or size 1
+  /// for the same K on every joint. Friction defaults to the model's Joint::damping /
+  /// Joint::friction. Throws extwrench::Error on a bad gain or an empty model.
+  MomentumObserver(const Model& model, const VectorX& gains);
+  MomentumObserver(const Model& model, double gain);
+
+  /// K expanded to n entries; throws extwrench::Error unless size 1 or n, entries finite > 0.
+  [[nodiscard]] static VectorX checked_gains(const VectorX& gains, int n);
 
   /// Sets K (size n or 1, every entry > 0 and finite). Throws extwrench::Error otherwise.
   /// Allocation-free; the residual keeps its value.
   void set_gains(const VectorX& gains);
-  void set_friction(const JointFriction& friction);  ///< throws extwrench::Error on bad sizes
+  /// Throws extwrench::Error on bad sizes. Once initialized, the integrand of the current
+  /// interval is corrected to the new friction at the last q̇.
+  void set_friction(const JointFriction& friction);
 
-  /// Adds a payload (mass properties in the frame of `body`) to body `body`, replacing any
-  /// previous payload on any body. The integral state is shifted by the momentum jump at the
-  /// last (q, q̇) so that r is continuous. Allocation-free. kWrongSize for a bad body index,
-  /// kNonFinite for a NaN/Inf entry or a negative mass (then nothing changes).
-  [[nodiscard]] Status set_payload(int body, const Inertia& payload) noexcept;
-  /// Removes the payload (same continuity as set_payload).
-  void clear_payload() noexcept;
-
-  /// Starts (or restarts) the observer at time t: r = 0, m(0) = B(q) q̇. The torque of the
-  /// interval [t, t_1) is `tau`; the overload without it takes the first update's torque.
-  [[nodiscard]] Status reset(double t, const Eigen::Ref<const VectorX>& q,
+  /// Starts (or restarts) the observer at time t: r = 0, m(0) = B(q) q̇ (momentum_terms on
+  /// `data`). The torque of the interval [t, t_1) is `tau`; the overload without it takes the
+  /// first update's torque.
+  [[nodiscard]] Status reset(const Model& model, Data& data, double t,
+                             const Eigen::Ref<const VectorX>& q,
                              const Eigen::Ref<const VectorX>& dq) noexcept;
-  [[nodiscard]] Status reset(double t, const Eigen::Ref<const VectorX>& q,
+  [[nodiscard]] Status reset(const Model& model, Data& data, double t,
+                             const Eigen::Ref<const VectorX>& q,
                              const Eigen::Ref<const VectorX>& dq,
                              const Eigen::Ref<const VectorX>& tau) noexcept;
 
   /// One sample: t > previous t, q, q̇, τ (commanded joint torques) of size n, all finite.
-  /// On an input error the Status names the channel and index and nothing is changed
-  /// (the state stays bit-identical). O(n), no allocation.
-  [[nodiscard]] Status update(double t, const Eigen::Ref<const VectorX>& q,
+  /// validate(), then momentum_terms(model, data, q, q̇), then integrate(). On an input error the
+  /// Status names the channel and index and nothing is changed (the state stays bit-identical).
+  /// O(n), no allocation.
+  [[nodiscard]] Status update(const Model& model, Data& data, double t,
+                              const Eigen::Ref<const VectorX>& q,
                               const Eigen::Ref<const VectorX>& dq,
                               const Eigen::Ref<const VectorX>& tau) noexcept;
 
@@ -69,44 +72,33 @@ class MomentumObserver {
                                 const Eigen::Ref<const VectorX>& dq,
                                 const Eigen::Ref<const VectorX>& tau) const noexcept;
 
+  /// The integration step of update() for a caller that validated (t, q, q̇, τ) and already ran
+  /// momentum_terms or momentum_and_bias_terms at (q, q̇): reads data.momentum,
+  /// data.coriolis_transpose_dq and data.gravity_torque; writes residual(), friction_torque().
+  void integrate(const Data& data, double t, const Eigen::Ref<const VectorX>& q,
+                 const Eigen::Ref<const VectorX>& dq,
+                 const Eigen::Ref<const VectorX>& tau) noexcept;
+
+  /// After an edit of the model's mass properties (a payload): recomputes the momentum of the
+  /// last (q, q̇) with `model` (momentum_terms on `data`), so that the next Δy contains no jump
+  /// and r stays continuous (the change is taken as made at t_k). Nothing to do before reset.
+  /// Allocation-free.
+  void reanchor(const Model& model, Data& data) noexcept;
+
   /// r ≈ τ̂_ext (n), after the last update (zero after reset).
   [[nodiscard]] const VectorX& residual() const noexcept { return r_; }
   [[nodiscard]] bool initialized() const noexcept { return initialized_; }
   [[nodiscard]] double time() const noexcept { return t_; }
   [[nodiscard]] const VectorX& gains() const noexcept { return gains_; }
-  /// The model in use (payload included).
-  [[nodiscard]] const Model& model() const noexcept { return model_; }
   [[nodiscard]] const JointFriction& friction() const noexcept { return friction_; }
   /// Friction torques τ_f(q̇) of the last sample (n).
   [[nodiscard]] const VectorX& friction_torque() const noexcept { return tau_f_; }
   [[nodiscard]] int nq() const noexcept { return n_; }
 
-  /// The dynamics workspace. After update()/reset() its poses and motion subspaces (X_WB, S)
-  /// are those of the last q, and momentum / coriolis_transpose_dq / gravity_torque those of
-  /// the last (q, q̇). The world-frame mass properties are not computed (the residual does not
-  /// need them): call world_mass_properties(model(), workspace()) before a *_no_kinematics
-  /// algorithm that reads them. Every other buffer is scratch that a caller (the
-  /// ContactEstimator) may overwrite between updates.
-  [[nodiscard]] Data& workspace() noexcept { return data_; }
-  [[nodiscard]] const Data& workspace() const noexcept { return data_; }
-
  private:
-  friend class ContactEstimator;  // validates the sample itself, then calls advance()
+  /// τ_f(q̇) and γ = Cᵀq̇ − g − τ_f from the momentum terms in `data`.
+  void integrand(const Data& data, const Eigen::Ref<const VectorX>& dq) noexcept;
 
-  /// What advance() leaves in the workspace besides the momentum terms and the poses.
-  enum class Extras { kNone, kWorldInertias, kWorldInertiasAndBias };
-  /// update() without the input checks: the caller has validated (t, q, q̇, τ).
-  void advance(double t, const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
-               const Eigen::Ref<const VectorX>& tau,
-               Extras extras = Extras::kNone) noexcept;
-  void compute_terms(const Eigen::Ref<const VectorX>& q, const Eigen::Ref<const VectorX>& dq,
-                     Extras extras = Extras::kNone) noexcept;
-  void apply_payload(int body, const Inertia* payload) noexcept;
-
-  Model model_;
-  std::vector<Inertia> nominal_inertia_;  ///< bodies' inertia without payload
-  int payload_body_ = -1;
-  Data data_;
   int n_ = 0;
   VectorX gains_;
   JointFriction friction_;

@@ -6,9 +6,9 @@
 #include <utility>
 #include <vector>
 
+#include "extwrench/core/sample.hpp"
 #include "extwrench/core/types.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
-#include "extwrench/sim/sample.hpp"
 
 namespace extwrench::sim {
 

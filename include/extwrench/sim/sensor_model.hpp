@@ -4,17 +4,16 @@
 #include <cstdint>
 
 #include "extwrench/core/types.hpp"
+#include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/sim/random.hpp"
 
 namespace extwrench::sim {
 
-enum class BaseSensorType { kNone, kForce, kForceTorque };
-
 /// The base sensor (SPEC 3): what the robot discharges onto it, in its own frame, moment about
 /// its origin, plus a constant bias and white Gaussian noise per axis.
 struct BaseSensorModel {
-  BaseSensorType type = BaseSensorType::kForceTorque;
-  Pose X_RS;                               ///< pose of the sensor frame in the robot's root frame
+  SensorType type = SensorType::kForceTorque;
+  Pose X_WS;                               ///< pose of the sensor frame in the robot's root frame W
   Vector6 bias = Vector6::Zero();          ///< [N; N m] added to every reading
   Vector3 force_noise = Vector3::Zero();   ///< standard deviation per axis [N]
   Vector3 moment_noise = Vector3::Zero();  ///< standard deviation per axis [N m]

@@ -6,7 +6,7 @@
 
 #include "extwrench/sim/controller.hpp"
 #include "extwrench/sim/force_profile.hpp"
-#include "extwrench/sim/sample.hpp"
+#include "extwrench/core/sample.hpp"
 #include "extwrench/sim/sensor_model.hpp"
 
 namespace extwrench::sim {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "extwrench/core/types.hpp"
+#include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
 #include "extwrench/io/number_text.hpp"
 #include "extwrench/model/model.hpp"

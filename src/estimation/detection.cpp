@@ -1,4 +1,4 @@
-#include "extwrench/estimation/contact_detector.hpp"
+#include "extwrench/estimation/detection.hpp"
 
 #include <cmath>
 #include <string>
@@ -11,15 +11,15 @@ namespace {
 constexpr double kTimeSlack = 1e-9;  // [s]
 }  // namespace
 
-ContactDetector::ContactDetector(const DetectionOptions& options, int n) : options_(options) {
+void validate(const DetectionOptions& options, int n) {
   const VectorX& t = options.tau_min;
   if (t.size() != 1 && t.size() != n) {
     throw Error("detection.tau_min: expected 1 or " + std::to_string(n) + " values, got " +
                 std::to_string(t.size()));
   }
-  tau_min_ = t.size() == 1 ? VectorX::Constant(n, t[0]) : t;
   for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(tau_min_[i]) || !(tau_min_[i] > 0.0)) {
+    const double v = t.size() == 1 ? t[0] : t[i];
+    if (!std::isfinite(v) || !(v > 0.0)) {
       throw Error("detection.tau_min[" + std::to_string(i) + "]: expected a finite value > 0");
     }
   }
@@ -32,6 +32,12 @@ ContactDetector::ContactDetector(const DetectionOptions& options, int n) : optio
   if (!std::isfinite(options.min_duration) || options.min_duration < 0.0) {
     throw Error("detection.min_duration: expected a finite value >= 0 [s]");
   }
+}
+
+ContactDetector::ContactDetector(const DetectionOptions& options, int n) : options_(options) {
+  validate(options, n);
+  const VectorX& t = options.tau_min;
+  tau_min_ = t.size() == 1 ? VectorX::Constant(n, t[0]) : t;
   joint_over_.setConstant(n, false);
 }
 

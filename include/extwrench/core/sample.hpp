@@ -6,7 +6,7 @@
 
 #include "extwrench/core/types.hpp"
 
-namespace extwrench::sim {
+namespace extwrench {
 
 /// Ground truth of a sample, world frame. With several simultaneous contacts, `link` lists the
 /// link names joined by '+', force and moment are sums and point is the first contact's.
@@ -33,4 +33,4 @@ struct Sample {
   Truth truth;
 };
 
-}  // namespace extwrench::sim
+}  // namespace extwrench

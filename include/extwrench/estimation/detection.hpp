@@ -7,9 +7,15 @@
 //    min_duration seconds (debouncing both edges);
 //  - link = the largest joint index over threshold (Remark 1: a wrench on link l only moves
 //    τ_ext,1..l); a base-sensor detection with no joint over threshold is link 0.
+//
+// Isolation (isolate): the link the wrench cases work on, from the detection and the contact
+// assumption (a known point names its link whatever the detection says).
 #pragma once
 
+#include <cstdint>
+
 #include "extwrench/core/types.hpp"
+#include "extwrench/estimation/contact_estimate.hpp"
 
 namespace extwrench {
 
@@ -29,10 +35,13 @@ struct DetectionResult {
   int link = -1;           ///< isolated link while `contact` (0 = link 0), −1 otherwise
 };
 
+/// Throws extwrench::Error on sizes other than 1 or n, or values out of range.
+void validate(const DetectionOptions& options, int n);
+
 class ContactDetector {
  public:
   ContactDetector() = default;
-  /// Throws extwrench::Error on sizes other than 1 or n, or values out of range.
+  /// Throws extwrench::Error on sizes other than 1 or n, or values out of range (validate).
   ContactDetector(const DetectionOptions& options, int n);
 
   void reset() noexcept;
@@ -54,5 +63,24 @@ class ContactDetector {
   int last_link_ = -1;
   DetectionResult result_;
 };
+
+/// The EstimateFlag bits of a detection result: contact, pending, base only.
+[[nodiscard]] inline std::uint32_t detection_flags(const DetectionResult& det) noexcept {
+  std::uint32_t flags = 0;
+  if (det.contact) flags |= EstimateFlag::kContact;
+  if (det.pending) flags |= EstimateFlag::kPending;
+  if (det.contact && det.base_only) flags |= EstimateFlag::kBaseOnly;
+  return flags;
+}
+
+/// Isolation rule. In: the detection, the contact assumption and, for a known point, its link.
+/// Out: the link the wrench cases work on (−1: none); kLinkMismatch added to `flags` when a
+/// declared contact is isolated on another link than the known point's.
+[[nodiscard]] inline int isolate(const DetectionResult& det, ContactModel model, int known_link,
+                                 std::uint32_t& flags) noexcept {
+  if (model != ContactModel::kKnownPoint) return det.contact ? det.link : -1;
+  if (det.contact && det.link != known_link) flags |= EstimateFlag::kLinkMismatch;
+  return known_link;
+}
 
 }  // namespace extwrench

@@ -1,0 +1,54 @@
+// The ContactEstimator's options and validate(), the one place where their ranges, sizes and
+// indices are checked against a model.
+#pragma once
+
+#include <optional>
+
+#include "extwrench/estimation/base_sensor.hpp"
+#include "extwrench/estimation/contact_estimate.hpp"
+#include "extwrench/estimation/damped_least_squares.hpp"
+#include "extwrench/estimation/detection.hpp"
+#include "extwrench/model/model.hpp"
+#include "extwrench/observer/friction.hpp"
+
+namespace extwrench {
+
+struct SensorOptions {
+  SensorType type = SensorType::kNone;
+  Pose pose;  ///< X_WS: pose of the sensor frame in the robot's root frame
+  int tare_samples =
+      0;  ///< > 0: bias = mean(reading − predicted) over the first samples after reset
+};
+
+struct ContactOptions {
+  ContactModel model = ContactModel::kPureForce;
+  int link = -1;                    ///< known point: body index of the contact link
+  Vector3 point = Vector3::Zero();  ///< known point: p in the link frame [m]
+};
+
+struct PayloadOptions {
+  int body = -1;    ///< body carrying the payload
+  Inertia inertia;  ///< mass properties in that body's frame
+};
+
+struct EstimatorOptions {
+  SensorOptions sensor;
+  ContactOptions contact;
+  VectorX observer_gain = VectorX::Constant(1, 100.0);  ///< K [1/s], size 1 or n
+  DetectionOptions detection;
+  AccelerationRoute acceleration = AccelerationRoute::kResidual;
+  double differentiation_cutoff = 50.0;   ///< [Hz] low-pass of the differentiated q̇ (route (a))
+  std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction
+  std::optional<PayloadOptions> payload;
+  SolverOptions solver;
+};
+
+/// Throws extwrench::Error if the options do not fit the model (sizes, link indices, ranges,
+/// finite payload) or the model is not a serial chain (isolation by joint index needs one).
+/// The ContactEstimator's constructor calls it first.
+void validate(const EstimatorOptions& options, const Model& model);
+
+/// Mass properties usable as a payload: finite, mass ≥ 0.
+[[nodiscard]] bool finite_inertia(const Inertia& in) noexcept;
+
+}  // namespace extwrench

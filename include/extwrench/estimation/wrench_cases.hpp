@@ -1,0 +1,110 @@
+// The cases of Table I on the isolated link l (docs/estimator.md), O_l the origin of body l's
+// frame, J_l = [J_v,l; J_ω,l] the Jacobian of O_l (6×n, zero beyond l):
+//   A  F̂ = f_m − f̃_g                                  (11)   force or F/T sensor (base_sensor.hpp)
+//   B  M̂ = n_m − ñ_g − r_{s,p} × F̂                    (16)   F/T, known point
+//   C  M̃ = n_m − r_{s,l} × F̂ − ñ_g,  r̂ = F̂ × M̃/‖F̂‖²  (17–20) F/T, pure force
+//   D  M̄̂ = (J_ω,lᵀ)# (τ̂_1:l − J_v,lᵀ F̂)               (26)   force sensor, rank J_ω,l = 3
+//   E  W̄ = (J_lᵀ)# τ̂_1:l                              (27)   no sensor, rank J_l = 6
+// The wrench is carried as (F̂, M̄), M̄ the moment about O_l (M̄ = M_ext + r_{l,p} × F_ext).
+// Real time: inline, noexcept, no allocation.
+#pragma once
+
+#include <cmath>
+#include <limits>
+
+#include "extwrench/estimation/base_sensor.hpp"
+#include "extwrench/estimation/damped_least_squares.hpp"
+
+namespace extwrench {
+
+/// The wrench of one Table I case. A quantity that was not estimated is NaN.
+struct WrenchFit {
+  Vector3 force_W = Vector3::Constant(std::numeric_limits<double>::quiet_NaN());  ///< F̂
+  Vector3 moment_O = Vector3::Constant(std::numeric_limits<double>::quiet_NaN());  ///< M̄, about O_l
+  bool ok = false;            ///< (F̂, M̄) estimated
+  bool damped = false;        ///< damped least squares active (cases D, E)
+  bool fitted_force = false;  ///< F̂ comes from the fit (case E), not the sensor
+  double condition = std::numeric_limits<double>::quiet_NaN();  ///< κ of the inverted Jacobian
+};
+
+/// Table I case stage. In: the sensor type, J = J_l (6×n), l, τ̂_ext (n), the base wrench
+/// (F̂, n_m − ñ_g of base_wrench; unused for kNone), O_l, the sensor origin p_WS, the solver
+/// options. Scratch: b (n), the spectrum guess of the damped solves. Out: the fit.
+template <typename Jacobian>
+[[nodiscard]] inline WrenchFit wrench_case(SensorType type, const Jacobian& J, int link,
+                                           const VectorX& tau_ext, const BaseWrench& base,
+                                           const Vector3& O_l, const Vector3& p_WS,
+                                           const SolverOptions& solver, VectorX& b,
+                                           SpectrumGuess& guess) noexcept {
+  WrenchFit fit;
+  if (type == SensorType::kForceTorque) {
+    // C (17): M̃ = n_m − ñ_g − r_{s,l} × F̂, the moment about O_l.
+    fit.force_W = base.force_W;
+    fit.moment_O = base.dn_W - (O_l - p_WS).cross(base.force_W);
+    fit.ok = true;
+  } else if (type == SensorType::kForce) {
+    // D (26): M̄̂ = (J_ω,lᵀ)# (τ̂_1:l − J_v,lᵀ F̂), rank J_ω,l = 3 required.
+    fit.force_W = base.force_W;
+    b = tau_ext;
+    b.noalias() -= J.template topRows<3>().transpose() * base.force_W;
+    Vector3 x;
+    const DlsInfo info = damped_solve<3>(J.template bottomRows<3>(), link, b, solver, x, guess);
+    fit.condition = info.condition;
+    if (info.rank_ok) {
+      fit.moment_O = x;
+      fit.ok = true;
+      fit.damped = info.damped;
+    }
+  } else {
+    // E (27): W̄ = (J_lᵀ)# τ̂_1:l, rank J_l = 6 required.
+    Vector6 x;
+    const DlsInfo info = damped_solve<6>(J, link, tau_ext, solver, x, guess);
+    fit.condition = info.condition;
+    if (info.rank_ok) {
+      fit.force_W = x.head<3>();
+      fit.moment_O = x.tail<3>();
+      fit.ok = true;
+      fit.damped = info.damped;
+      fit.fitted_force = true;
+    }
+  }
+  return fit;
+}
+
+/// Known point (16). In: the fit (ok), the point p_W, O_l. Out: M̂_ext = M̄ − r_{l,p} × F̂
+/// (= n_m − ñ_g − r_{s,p} × F̂ with the F/T sensor).
+[[nodiscard]] inline Vector3 known_point_moment(const WrenchFit& fit, const Vector3& p_W,
+                                                const Vector3& O_l) noexcept {
+  return fit.moment_O - (p_W - O_l).cross(fit.force_W);
+}
+
+/// Line of action (19)–(21). In: the fit (ok), O_l. Out: p̂ = O_l + F̂ × M̄ / ‖F̂‖², the point of
+/// the line nearest O_l, and the unit direction F̂/‖F̂‖; false when ‖F̂‖ is 0 or not finite.
+[[nodiscard]] inline bool line_of_action(const WrenchFit& fit, const Vector3& O_l,
+                                         Vector3& line_point_W, Vector3& direction_W) noexcept {
+  const Vector3& F = fit.force_W;
+  const double f2 = F.squaredNorm();
+  if (!(f2 > 0.0 && std::isfinite(f2))) return false;
+  line_point_W = O_l + F.cross(fit.moment_O) / f2;
+  direction_W = F / std::sqrt(f2);
+  return true;
+}
+
+/// Consistency: a single wrench on link l must reproduce τ̂_ext = J_lᵀ (F̂, M̄) on every joint
+/// within τ_min. In: J = J_l, the fit, τ̂_ext, τ_min (n). Scratch: tau_pred (n). True when some
+/// joint differs by more than its τ_min (two contacts, or a contact on another link).
+template <typename Jacobian>
+[[nodiscard]] inline bool contradicts_residual(const Jacobian& J, const WrenchFit& fit,
+                                               const VectorX& tau_ext, const VectorX& tau_min,
+                                               VectorX& tau_pred) noexcept {
+  Vector6 w;
+  w << fit.force_W, fit.moment_O;
+  tau_pred.noalias() = J.transpose() * w;
+  bool inconsistent = false;
+  for (Eigen::Index i = 0; i < tau_pred.size(); ++i) {
+    if (std::abs(tau_pred[i] - tau_ext[i]) > tau_min[i]) inconsistent = true;
+  }
+  return inconsistent;
+}
+
+}  // namespace extwrench

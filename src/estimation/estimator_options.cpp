@@ -1,0 +1,74 @@
+#include "extwrench/estimation/estimator_options.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/observer/momentum_observer.hpp"
+
+namespace extwrench {
+namespace {
+
+void validate_contact(const ContactOptions& c, const Model& model, const std::string& where) {
+  if (c.model != ContactModel::kKnownPoint) return;
+  if (c.link < 0 || c.link >= model.num_bodies()) {
+    throw Error(where + ": contact.link: body index " + std::to_string(c.link) + " is not in [0, " +
+                std::to_string(model.num_bodies() - 1) + "]");
+  }
+  if (!c.point.allFinite()) throw Error(where + ": contact.point: expected finite values");
+}
+
+void validate_sensor(const SensorOptions& s, const std::string& where) {
+  const Pose& X = s.pose;
+  if (!X.translation.allFinite() || !X.rotation.allFinite() ||
+      !(X.rotation * X.rotation.transpose()).isIdentity(1e-9) || X.rotation.determinant() < 0) {
+    throw Error(where + ": sensor.pose: expected a finite rigid transform");
+  }
+  if (s.tare_samples < 0) throw Error(where + ": sensor.tare: expected a sample count >= 0");
+}
+
+void validate_numerics(const EstimatorOptions& o, const std::string& where) {
+  if (!(o.differentiation_cutoff > 0.0) || !std::isfinite(o.differentiation_cutoff)) {
+    throw Error(where + ": acceleration cutoff: expected a finite value > 0 [Hz]");
+  }
+  if (!(o.solver.max_condition > 1.0) || !std::isfinite(o.solver.max_condition)) {
+    throw Error(where + ": solver.max_condition: expected a finite value > 1");
+  }
+  if (!(o.solver.rank_tolerance > 0.0 && o.solver.rank_tolerance < 1.0)) {
+    throw Error(where + ": solver.rank_tolerance: expected a value in (0, 1)");
+  }
+}
+
+}  // namespace
+
+bool finite_inertia(const Inertia& in) noexcept {
+  return std::isfinite(in.mass) && in.mass >= 0.0 && in.com.allFinite() &&
+         in.inertia_com.allFinite();
+}
+
+void validate(const EstimatorOptions& o, const Model& model) {
+  const std::string where = "estimator for robot '" + model.name + "'";
+  if (!model.is_serial_chain()) {
+    throw Error(where + ": the model is not a serial chain; isolation by joint index needs one");
+  }
+  validate_contact(o.contact, model, where);
+  validate_sensor(o.sensor, where);
+  validate_numerics(o, where);
+  if (o.payload && (o.payload->body < 0 || o.payload->body >= model.num_bodies())) {
+    throw Error(where + ": payload.link: body index " + std::to_string(o.payload->body) +
+                " is not in the model");
+  }
+  // The observer's and the detector's own checks, in the order the estimator builds them.
+  const int n = model.nq();
+  if (n < 1) throw Error("MomentumObserver: model '" + model.name + "' has no joint");
+  (void)MomentumObserver::checked_gains(o.observer_gain, n);
+  validate_friction(JointFriction::from_model(model), n,
+                    "MomentumObserver: model '" + model.name + "'");
+  validate(o.detection, n);
+  if (o.friction) validate_friction(*o.friction, n, "MomentumObserver");
+  if (o.payload && !finite_inertia(o.payload->inertia)) {
+    throw Error(where + ": payload: non-finite or negative mass properties");
+  }
+}
+
+}  // namespace extwrench
