@@ -36,7 +36,7 @@ int main(int argc, char** argv) {
   const sim::PidGains pd{VectorX::Constant(n, 100.0), VectorX::Constant(n, 20.0), VectorX::Zero(n)};
   sim::SimulationConfig config;
   config.duration = 3.0;
-  config.sensor.X_RS = X_WS;
+  config.sensor.X_WS = X_WS;
   sim::ForceProfile push;  // the paper's contact: 20 N at a point of link 6, fixed in frame 6
   push.frame = "link6";
   push.force = Vector3(20.0, 0.0, 0.0);
@@ -56,11 +56,11 @@ int main(int argc, char** argv) {
   std::printf("%6s %7s %5s %24s %26s %8s  %s\n", "t[s]", "contact", "link", "F_hat [N] (world)",
               "surface point [m] (world)", "|F-F_hat|", "flags");
   double worst_us = 0.0, total_us = 0.0;
-  sim::Sample s;
+  Sample s;
   if (!simulator.next(s) || !estimator.reset(s.t, s.q, s.dq, s.tau).ok()) return 1;
   for (long k = 1; simulator.next(s); ++k) {
     const auto start = std::chrono::steady_clock::now();
-    const Status status = estimator.update(s.t, s.q, s.dq, s.tau, s.sensor);
+    const Status status = estimator.update(s);
     const double us =
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
     worst_us = std::max(worst_us, us);
