@@ -18,7 +18,8 @@ namespace {
 // a thin rod (I_zz = 0, I_xx = I_yy) sits exactly on the boundary and must pass after the
 // rounding of a text file (about 1e-9 relative with 9-10 printed digits).
 constexpr double kInertiaRelTol = 1e-8;
-// Smallest eigenvalue of M(0) relative to its largest below which M(0) counts as singular.
+// Pivot of M(0) (articulated-body inertia along a joint's axis) relative to the joint's
+// diagonal entry (composite inertia) below which M(0) counts as singular.
 constexpr double kMassMatrixRelTol = 1e-12;
 // |axis| below this is a zero axis.
 constexpr double kMinAxisNorm = 1e-12;
@@ -54,62 +55,67 @@ const char* type_name(JointSpecType t) {
   return "unknown";
 }
 
-// Joint-space mass matrix at q = 0, from per-body 6D Jacobians: M = sum_b J_b^T I_b J_b, with
-// world-frame spatial inertias about the world origin ([linear; angular] order). Kept here
-// (and not borrowed from dynamics/) so that validation does not depend on the algorithms it
-// guards.
-MatrixX mass_matrix_at_zero(const Model& model) {
-  const int nb = model.num_bodies();
-  const int n = model.nq();
-  std::vector<Pose> X_WB(static_cast<std::size_t>(nb));
-  std::vector<Vector6> S(static_cast<std::size_t>(nb), Vector6::Zero());
-  for (int i = 1; i < nb; ++i) {
-    const auto ui = static_cast<std::size_t>(i);
-    const Joint& j = model.joints[ui];
-    X_WB[ui] = X_WB[static_cast<std::size_t>(model.parents[ui])] * j.placement;
-    const Vector3 axis_W = X_WB[ui].rotation * j.axis;
-    if (j.type == JointType::kRevolute) {
-      // Velocity of the body point at the world origin: w x (0 - p) = p x w.
-      S[ui] << X_WB[ui].translation.cross(axis_W), axis_W;
-    } else {
-      S[ui] << axis_W, Vector3::Zero();
-    }
-  }
-  MatrixX M = MatrixX::Zero(n, n);
-  Matrix6X J(6, n);
-  for (int b = 1; b < nb; ++b) {
-    const auto ub = static_cast<std::size_t>(b);
-    const Inertia& in = model.bodies[ub].inertia;
-    const double m = in.mass;
-    const Vector3 c = X_WB[ub].act(in.com);
-    const Matrix3 Sc = skew(c);
-    Matrix6 I6;
-    I6.topLeftCorner<3, 3>() = m * Matrix3::Identity();
-    I6.topRightCorner<3, 3>() = -m * Sc;
-    I6.bottomLeftCorner<3, 3>() = m * Sc;
-    I6.bottomRightCorner<3, 3>() =
-        X_WB[ub].rotation * in.inertia_com * X_WB[ub].rotation.transpose() - m * Sc * Sc;
-    J.setZero();
-    for (int k = b; k > 0; k = model.parents[static_cast<std::size_t>(k)]) {
-      J.col(k - 1) = S[static_cast<std::size_t>(k)];
-    }
-    M.noalias() += J.transpose() * I6 * J;
-  }
-  return M;
+// Spatial inertia of a body about its own origin, in its own frame, [linear; angular] order.
+Matrix6 spatial_inertia(const Inertia& in) {
+  const Matrix3 Sc = skew(in.com);
+  Matrix6 I6;
+  I6.topLeftCorner<3, 3>() = in.mass * Matrix3::Identity();
+  I6.topRightCorner<3, 3>() = -in.mass * Sc;
+  I6.bottomLeftCorner<3, 3>() = in.mass * Sc;
+  I6.bottomRightCorner<3, 3>() = in.inertia_com - in.mass * Sc * Sc;
+  return I6;
 }
 
-// Body whose joint makes M(0) singular (the largest entry of the null eigenvector), or -1.
+// Motion transform from the parent's frame to the body's (X_PB = joint placement at q = 0):
+// v_B = R^T (v_P - t x w_P), w_B = R^T w_P.
+Matrix6 motion_parent_to_body(const Pose& X_PB) {
+  const Matrix3 Rt = X_PB.rotation.transpose();
+  Matrix6 X = Matrix6::Zero();
+  X.topLeftCorner<3, 3>() = Rt;
+  X.topRightCorner<3, 3>() = -Rt * skew(X_PB.translation);
+  X.bottomRightCorner<3, 3>() = Rt;
+  return X;
+}
+
+// Body whose joint makes M(q = 0) singular, or -1; O(n) in the number of bodies.
+// M(0) is positive definite iff every pivot of its tree-ordered factorisation is positive; the
+// pivots are the articulated-body inertias projected on the joint axes, D_i = S_i^T I^A_i S_i
+// (leaves first, Featherstone's articulated-body recursion). D_i = 0 means the subtree below
+// joint i, with the joints below it free, carries no mass or inertia along i's motion (e.g. a
+// massless leaf). Each pivot is judged against its own joint's diagonal entry M_ii =
+// S_i^T I^C_i S_i (composite inertia: the subtree rigid), the inertia it has when the joints
+// below are locked: a long chain's tip is then as well judged as its root, where one global
+// scale would grow as n^3 and reject it. Kept here (and not borrowed from dynamics/) so that validation does not
+// depend on the algorithms it guards.
 int singular_mass_matrix_body(const Model& model) {
+  const int nb = model.num_bodies();
   if (model.nq() == 0) return -1;
-  const MatrixX M = mass_matrix_at_zero(model);
-  if (!M.allFinite()) return 1;
-  Eigen::SelfAdjointEigenSolver<MatrixX> eig(M);
-  const VectorX& lambda = eig.eigenvalues();
-  const double scale = std::max(lambda.cwiseAbs().maxCoeff(), 1e-300);
-  if (lambda(0) > kMassMatrixRelTol * scale) return -1;
-  Eigen::Index k = 0;
-  eig.eigenvectors().col(0).cwiseAbs().maxCoeff(&k);
-  return static_cast<int>(k) + 1;
+  std::vector<Matrix6> IA(static_cast<std::size_t>(nb));
+  std::vector<Matrix6> IC(static_cast<std::size_t>(nb));
+  std::vector<Vector6> S(static_cast<std::size_t>(nb), Vector6::Zero());
+  for (int i = 0; i < nb; ++i) {
+    const auto ui = static_cast<std::size_t>(i);
+    IA[ui] = IC[ui] = spatial_inertia(model.bodies[ui].inertia);
+    const Joint& j = model.joints[ui];
+    // The axis passes through the body's origin: a revolute joint moves it without velocity.
+    if (j.type == JointType::kRevolute) {
+      S[ui] << Vector3::Zero(), j.axis;
+    } else {
+      S[ui] << j.axis, Vector3::Zero();
+    }
+  }
+  for (int i = nb - 1; i > 0; --i) {
+    const auto ui = static_cast<std::size_t>(i);
+    const Matrix6 X = motion_parent_to_body(model.joints[ui].placement);
+    const Vector6 U = IA[ui] * S[ui];
+    const double D = S[ui].dot(U);
+    const double M_ii = S[ui].dot(IC[ui] * S[ui]);
+    if (!std::isfinite(M_ii) || !(D > kMassMatrixRelTol * M_ii)) return i;
+    IC[static_cast<std::size_t>(model.parents[ui])] += X.transpose() * IC[ui] * X;
+    const Matrix6 Ia = IA[ui] - U * U.transpose() / D;
+    IA[static_cast<std::size_t>(model.parents[ui])] += X.transpose() * Ia * X;
+  }
+  return -1;
 }
 
 }  // namespace
@@ -434,6 +440,11 @@ void ModelBuilder::check_massless_bodies(const Model& model,
 Model ModelBuilder::build() const {
   const std::string model_where = "robot '" + name_ + "'";
   if (links_.empty()) throw Error(model_where + ": no links");
+  if (links_.size() > kMaxLinks || joints_.size() > kMaxLinks) {
+    throw Error(model_where + ": " + std::to_string(links_.size()) + " links and " +
+                std::to_string(joints_.size()) + " joints, more than the limit of " +
+                std::to_string(kMaxLinks) + " (docs/model.md)");
+  }
   if (!gravity_.allFinite()) throw Error(model_where + ": gravity: expected finite numbers");
   Topology topology = index_links();
   connect_joints(topology);

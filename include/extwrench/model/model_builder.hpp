@@ -3,6 +3,7 @@
 // each error message starts with, so errors name the file and line of the offending element.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -43,6 +44,10 @@ struct FrameSpec {
   Pose placement;  ///< X_{link, frame}
   std::string source;
 };
+
+/// Most links (and so joints) a model may have (docs/model.md "Limits"); building is linear in
+/// them, a larger description is refused before any work.
+inline constexpr std::size_t kMaxLinks = 100'000;
 
 class ModelBuilder {
  public:
