@@ -17,6 +17,7 @@
 #endif
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/input_file.hpp"
 #include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
@@ -45,8 +46,11 @@ std::string shown(std::string_view cell) {
 // ------------------------------------------------------------------------------------------
 // CsvReader
 
-CsvReader::CsvReader(const std::filesystem::path& path)
-    : owned_stream_(std::make_unique<std::ifstream>(path, std::ios::binary)), name_(path.string()) {
+CsvReader::CsvReader(const std::filesystem::path& path) : name_(path.string()) {
+  // A FIFO or a device would be read without end (or block): regular files only; a stream is
+  // read through the other constructor, when a command says so ('-').
+  if (std::error_code ec; std::filesystem::exists(path, ec)) check_input_file(path, "CSV");
+  owned_stream_ = std::make_unique<std::ifstream>(path, std::ios::binary);
   if (!*owned_stream_) throw Error(name_ + ": cannot open the file for reading");
   in_ = owned_stream_.get();
   read_header();
@@ -93,7 +97,13 @@ void CsvReader::refill() {
   if (buffer_.size() < kReadChunk) {
     buffer_.resize(kReadChunk);
   } else if (kept == buffer_.size()) {
-    buffer_.resize(2 * buffer_.size());
+    // The cap keeps memory independent of the input: a line without end is an error, not a
+    // buffer as large as the file.
+    if (kept >= kCsvMaxLineBytes) {
+      throw Error(name_ + ":" + std::to_string(next_line_) + ": line longer than " +
+                  std::to_string(kCsvMaxLineBytes) + " bytes (the limit, docs/cli.md)");
+    }
+    buffer_.resize(std::min(2 * buffer_.size(), kCsvMaxLineBytes));
   }
   const std::size_t wanted = buffer_.size() - kept;
   in_->read(buffer_.data() + kept, static_cast<std::streamsize>(wanted));
@@ -114,6 +124,7 @@ void CsvReader::split_line() {
   std::size_t start = 0;  // of the current cell
   std::size_t i = 0;
   auto cut = [&](std::size_t comma) {
+    if (cells_.size() + 1 >= kCsvMaxColumns) too_many_columns();
     cells_.push_back(trim(std::string_view(begin + start, comma - start)));
     start = comma + 1;
   };
@@ -138,6 +149,11 @@ void CsvReader::split_line() {
     }
   }
   cells_.push_back(trim(std::string_view(begin + start, size - start)));
+}
+
+void CsvReader::too_many_columns() const {
+  throw Error(where() + "more than " + std::to_string(kCsvMaxColumns) +
+              " columns (the limit, docs/cli.md)");
 }
 
 void CsvReader::split_quoted_line() {
@@ -171,6 +187,7 @@ void CsvReader::split_quoted_line() {
         throw Error(where() + "column " + std::to_string(first_column) +
                     ": unterminated quoted cell (a quoted cell cannot span lines)");
       }
+      if (cells_.size() + 1 >= kCsvMaxColumns) too_many_columns();
       cells_.emplace_back(unquoted_.data() + start, unquoted_.size() - start);
       while (i < line.size() && is_blank(line[i])) ++i;
       if (i < line.size() && line[i] != ',') {
@@ -185,6 +202,7 @@ void CsvReader::split_quoted_line() {
             where() + "column " + std::to_string(cells_.size() + 1) +
             ": a quote inside an unquoted cell (quote the whole cell and double the quote)");
       }
+      if (cells_.size() + 1 >= kCsvMaxColumns) too_many_columns();
       cells_.push_back(cell);
       i = comma;
     }

@@ -33,6 +33,11 @@
 
 namespace extwrench {
 
+/// Limits of the reader (docs/cli.md "Limits"): a longer line or a row (or header) with more
+/// cells is an error naming file and line, so memory stays bounded by them whatever the input.
+inline constexpr std::size_t kCsvMaxLineBytes = std::size_t{16} << 20;  // 16 MiB
+inline constexpr std::size_t kCsvMaxColumns = 100'000;
+
 class CsvReader {
  public:
   /// Opens `path` and reads its header. Throws extwrench::Error if the file cannot be opened,
@@ -83,6 +88,7 @@ class CsvReader {
   void refill();
   void split_line();
   void split_quoted_line();
+  [[noreturn]] void too_many_columns() const;
   [[noreturn]] void fail_number(int column, std::string_view reason) const;
   double parse(int column, bool allow_missing) const;
 
