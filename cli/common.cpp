@@ -8,6 +8,7 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
+#include "extwrench/io/input_file.hpp"
 #include "extwrench/io/number_text.hpp"
 
 namespace extwrench::cli {
@@ -51,10 +52,7 @@ void add_package_path_option(CLI::App& sub, std::vector<std::filesystem::path>& 
 
 RobotDescription load_robot_file(const std::filesystem::path& path,
                                  const std::vector<std::filesystem::path>& package_path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error(path.string() + ": no such robot file");
-  }
+  check_input_file(path, "robot", kMaxTextFileBytes);
   LoadOptions options;
   options.package_path = package_path;
   return load_robot(path, options);

@@ -8,6 +8,7 @@
 #include "extwrench/app/replay.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/estimator_config.hpp"
+#include "extwrench/io/input_file.hpp"
 #include "extwrench/io/number_text.hpp"
 
 namespace extwrench::cli {
@@ -47,9 +48,7 @@ void run_estimate(const EstimateOptions& opt) {
   LoadOptions load;
   load.package_path = opt.package_path;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(opt.log, ec))
-    throw Error(opt.log.string() + ": no such log file");
+  check_input_file(opt.log, "log");
 
   ReplayOptions replay;
   replay.log = opt.log;

@@ -209,13 +209,17 @@ std::string list3(const Vector3& v) {
 
 EstimatorConfig load_estimator_config(const std::filesystem::path& path,
                                       const LoadOptions& robot_options) {
-  return interpret(io_detail::load_yaml_file(path, "configuration"), path, robot_options);
+  return io_detail::at_loader_boundary(path.string(), [&] {
+    return interpret(io_detail::load_yaml_file(path, "configuration"), path, robot_options);
+  });
 }
 
 EstimatorConfig load_estimator_config_string(const std::string& yaml,
                                              const std::filesystem::path& name,
                                              const LoadOptions& robot_options) {
-  return interpret(io_detail::load_yaml_string(yaml, name.string()), name, robot_options);
+  return io_detail::at_loader_boundary(name.string(), [&] {
+    return interpret(io_detail::load_yaml_string(yaml, name.string()), name, robot_options);
+  });
 }
 
 ContactEstimator make_estimator(const EstimatorConfig& config) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/input_file.hpp"
 #include "extwrench/io/mesh.hpp"
 
 namespace extwrench {
@@ -66,6 +67,8 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& path,
   if (!scale.allFinite() || (scale.array() == 0.0).any()) {
     throw Error(name + ": mesh scale must be finite and non-zero");
   }
+  // Before assimp opens it: a directory, FIFO or device must not reach the importer.
+  check_input_file(path, "mesh", kMaxMeshFileBytes);
   Assimp::Importer importer;
   // URDF tools read Collada in the file's own axes. Normals are dropped (they come from the
   // winding) so that vertices are joined by position alone.
@@ -78,6 +81,11 @@ std::shared_ptr<const TriangleMesh> load_mesh(const std::filesystem::path& path,
   Soup soup;
   collect(*scene, *scene->mRootNode, aiMatrix4x4(), soup);
   if (soup.triangles.empty()) throw Error(name + ": mesh has no triangles");
+  if (soup.triangles.size() > kMaxMeshTriangles) {
+    throw Error(name + ": " + std::to_string(soup.triangles.size()) +
+                " triangles, more than the limit of " + std::to_string(kMaxMeshTriangles) +
+                " (docs/model.md)");
+  }
 
   Matrix3X vertices(3, static_cast<Eigen::Index>(soup.vertices.size()));
   for (std::size_t i = 0; i < soup.vertices.size(); ++i) {

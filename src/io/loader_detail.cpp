@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/input_file.hpp"
 #include "extwrench/io/mesh.hpp"
 
 namespace extwrench::io_detail {
@@ -87,8 +88,16 @@ std::optional<fs::path> resolve_mesh_path(const std::string& uri, const fs::path
     p = fs::path(uri);
     if (p.is_relative()) p = base_dir / p;
   }
-  if (!exists_file(p)) {
+  std::error_code ec;
+  if (!fs::exists(p, ec)) {
     if (why) *why = "mesh file '" + p.string() + "' not found (from '" + uri + "')";
+    return std::nullopt;
+  }
+  try {
+    // There, but a directory, a FIFO, a device or too large: say which.
+    check_input_file(p, "mesh", kMaxMeshFileBytes);
+  } catch (const Error& e) {
+    if (why) *why = std::string(e.what()) + " (from '" + uri + "')";
     return std::nullopt;
   }
   return p;

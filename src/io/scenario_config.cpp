@@ -231,7 +231,9 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
       y.fail(kv.second["robot"], k + ".robot",
              "schemes use the scenario's perturbed model; remove 'robot'");
     }
-    if (!kv.second["sensor"] || !kv.second["sensor"]["type"]) {
+    const YAML::Node sensor = kv.second["sensor"];
+    if (sensor && !sensor.IsMap()) y.fail(sensor, k + ".sensor", "expected a mapping (type: ...)");
+    if (!sensor || !sensor["type"]) {
       y.fail(kv.second, k + ".sensor.type", "missing (ft, force or none)");
     }
     YAML::Emitter out;
@@ -242,7 +244,9 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
 
 }  // namespace
 
-Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& robot_options) {
+namespace {
+
+Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& robot_options) {
   const YamlReader y(path.string(), kScenarioNumber);
   const YAML::Node root = io_detail::load_yaml_file(path, "scenario");
   if (!root.IsDefined() || root.IsNull()) throw Error(y.file() + ": the scenario is empty");
@@ -271,6 +275,13 @@ Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& rob
   if (root["figures"]) s.figures = y.boolean(root["figures"], "figures");
   parse_schemes(y, root, s);
   return s;
+}
+
+}  // namespace
+
+Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& robot_options) {
+  return io_detail::at_loader_boundary(path.string(),
+                                       [&] { return read_scenario(path, robot_options); });
 }
 
 namespace {

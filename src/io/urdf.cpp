@@ -3,11 +3,14 @@
 // attribute and the offending text. The subset and the <capsule> extension: docs/model.md.
 #include <tinyxml2.h>
 
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/input_file.hpp"
 #include "extwrench/io/number_text.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/model/model_builder.hpp"
@@ -22,6 +25,23 @@ namespace fs = std::filesystem;
 // Attributes are finite numbers, spaces around them allowed (urdfdom would read "abc" as 0).
 constexpr NumberRules kUrdfNumber{.trim_space = true};
 using tinyxml2::XMLElement;
+
+// Text from the file as messages show it: control and non-ASCII bytes as \xNN, cut at 60.
+std::string shown(std::string_view text) {
+  constexpr std::size_t kMax = 60;
+  std::string out;
+  for (const char c : text.substr(0, kMax)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", u);
+      out += hex;
+    }
+  }
+  return text.size() > kMax ? out + "..." : out;
+}
 
 class UrdfParser {
  public:
@@ -41,6 +61,11 @@ class UrdfParser {
     }
     ModelBuilder builder;
     if (const char* name = robot->Attribute("name")) builder.set_name(name);
+    if (robot->FirstChildElement("link") == nullptr) {
+      const char* name = robot->Attribute("name");
+      throw Error(where(robot) + ": <robot" + (name ? " '" + shown(name) + "'" : std::string()) +
+                  ">: no <link> elements (a robot needs at least one link)");
+    }
     if (options.gravity) builder.set_gravity(*options.gravity);
     // Only direct children: <link> inside <gazebo> & co. are not links. Unknown elements
     // (<gazebo>, <transmission>, <material>, <mujoco>, ...) are extensions and ignored.
@@ -254,9 +279,13 @@ class UrdfParser {
         j.lower = number(limit, "lower", owner, 0.0);
         j.upper = number(limit, "upper", owner, 0.0);
         if (j.lower > j.upper) {
+          // Either may be missing (it then defaults to 0): never append a null attribute.
+          const auto text = [&](const char* attr) {
+            const char* v = limit->Attribute(attr);
+            return v ? "'" + std::string(v) + "'" : std::string("0 (missing, default)");
+          };
           fail(limit, owner,
-               std::string("attributes 'lower' > 'upper' ('") + limit->Attribute("lower") +
-                   "' > '" + limit->Attribute("upper") + "')");
+               "attributes 'lower' > 'upper' (" + text("lower") + " > " + text("upper") + ")");
         }
       }
       if (j.effort_limit < 0.0)
@@ -290,13 +319,10 @@ RobotDescription load_urdf_string(const std::string& xml, const std::string& nam
 }
 
 RobotDescription load_urdf(const fs::path& path, const LoadOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path.string() + ": cannot open file");
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string text = read_input_file(path, "robot");
   UrdfParser parser(path.string());
-  RobotDescription r = parser.parse(
-      text.str(), path.parent_path().empty() ? fs::path(".") : path.parent_path(), options);
+  RobotDescription r =
+      parser.parse(text, path.parent_path().empty() ? fs::path(".") : path.parent_path(), options);
   r.source = path;
   return r;
 }

@@ -46,7 +46,13 @@ const std::map<std::string, Expected>& cases() {
        {19, {"<origin> of joint 'j1'", "attribute 'rpy'", "got '0 0 x'"}}},
       {"axis_zero.urdf", {20, {"<axis> of joint 'j1'", "attribute 'xyz'", "must not be zero"}}},
       {"limit_lower_above_upper.urdf",
-       {21, {"<limit> of joint 'j1'", "'lower' > 'upper'", "'2' > '1'"}}},
+       {21, {"<limit> of joint 'j1'", "'lower' > 'upper'", "('2' > '1')"}}},
+      // Only one bound given, the other defaulting to 0 (issue 14: the message once appended
+      // the missing attribute, a null pointer, and crashed).
+      {"limit_lower_only_positive.urdf",
+       {21, {"<limit> of joint 'j1'", "'lower' > 'upper' ('1' > 0 (missing, default))"}}},
+      {"limit_upper_only_negative.urdf",
+       {21, {"<limit> of joint 'j1'", "'lower' > 'upper' (0 (missing, default) > '-1')"}}},
       {"limit_missing.urdf", {16, {"<joint> of joint 'j1'", "missing element <limit>"}}},
       {"limit_missing_effort.urdf", {21, {"<limit> of joint 'j1'", "attribute 'effort': missing"}}},
       {"limit_negative_velocity.urdf",

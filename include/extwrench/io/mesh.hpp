@@ -1,6 +1,7 @@
 // Triangle meshes from files (assimp) with an Embree line-query structure attached.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -9,6 +10,9 @@
 #include "extwrench/geometry/shapes.hpp"
 
 namespace extwrench {
+
+/// Most triangles a mesh may have (docs/model.md "Limits").
+inline constexpr std::size_t kMaxMeshTriangles = 20'000'000;
 
 /// Loads every triangle of a mesh file (STL, OBJ, DAE, ... anything assimp reads): all meshes
 /// of the scene merged, node transforms applied, identical vertices joined, polygons

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/input_file.hpp"
 
 namespace extwrench::io_detail {
 namespace {
@@ -37,11 +38,7 @@ YAML::Node load_yaml_string(const std::string& text, const std::string& name) {
 }
 
 YAML::Node load_yaml_file(const std::filesystem::path& path, const std::string& what) {
-  std::ifstream in(path);
-  if (!in) throw Error(path.string() + ": cannot open the " + what + " file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return load_yaml_string(ss.str(), path.string());
+  return load_yaml_string(read_input_file(path, what), path.string());
 }
 
 YamlReader::YamlReader(std::string file, NumberRules rules)
@@ -72,6 +69,12 @@ void YamlReader::only_keys(const YAML::Node& map, const std::string& context,
   if (!map.IsMap()) fail(map, context.empty() ? "(top level)" : context, "expected a mapping");
   const std::set<std::string> ok(allowed.begin(), allowed.end());
   for (const auto& kv : map) {
+    if (!kv.first.IsScalar()) {
+      fail(kv.first, context.empty() ? "(top level)" : context,
+           std::string("a key must be a name, got a ") + (kv.first.IsMap()        ? "mapping"
+                                                          : kv.first.IsSequence() ? "list"
+                                                                                  : "null"));
+    }
     const std::string k = kv.first.Scalar();
     if (ok.count(k) == 0)
       fail(kv.first, key(context, k), "unknown key (expected one of: " + listed(allowed) + ")");

@@ -8,8 +8,10 @@
 #include <cstddef>
 #include <filesystem>
 #include <initializer_list>
+#include <ios>
 #include <string>
 
+#include "extwrench/core/error.hpp"
 #include "extwrench/core/types.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
@@ -32,6 +34,21 @@ Range non_negative(const char* text = ">= 0");
 
 /// Parses a whole YAML text; a syntax error becomes "name:line: YAML syntax error: ...".
 YAML::Node load_yaml_string(const std::string& text, const std::string& name);
+/// Runs `read`, turning what yaml-cpp or the standard library throws past the readers (a
+/// conversion of a value of an unexpected kind, a stream error) into extwrench::Error
+/// "file:line: what", so every message names the file: the loaders' boundary.
+template <class F>
+auto at_loader_boundary(const std::string& file, F&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const YAML::Exception& e) {
+    throw Error(file + ":" + std::to_string(e.mark.line < 0 ? 1 : e.mark.line + 1) + ": " + e.msg +
+                " (a value of an unexpected kind)");
+  } catch (const std::ios_base::failure& e) {
+    throw Error(file + ": read error: " + e.what());
+  }
+}
+
 /// Reads and parses a file; "path: cannot open the <what> file" when it cannot be read.
 YAML::Node load_yaml_file(const std::filesystem::path& path, const std::string& what);
 
