@@ -1,5 +1,6 @@
 #include "extwrench/app/replay.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -21,8 +22,13 @@ std::string title_of(const ReplayOptions& o) {
 
 void note_ignored_columns(const LogReader& reader) {
   if (reader.ignored_columns().empty()) return;
+  // The first few names say enough; a log of 10 000 stray columns must not print them all.
+  constexpr std::size_t kShown = 10;
+  const auto& ignored = reader.ignored_columns();
   std::string list;
-  for (const auto& c : reader.ignored_columns()) list += (list.empty() ? "" : ", ") + c;
+  for (std::size_t i = 0; i < std::min(ignored.size(), kShown); ++i)
+    list += (list.empty() ? "" : ", ") + ignored[i];
+  if (ignored.size() > kShown) list += " and " + std::to_string(ignored.size() - kShown) + " more";
   std::cerr << "extwrench: note: " << reader.name()
             << ": ignoring columns not in the log format: " << list << "\n";
 }
@@ -126,9 +132,12 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   const LogLayout layout = reader.layout();  // a copy: the reader moves to its thread
   if (o.warn_ignored_columns) note_ignored_columns(reader);
   check_sensor_columns(reader, estimator_options.sensor.type);
-  std::filesystem::create_directories(o.out_dir);
+  OutputFiles own_outputs;
+  OutputFiles& outputs = o.outputs != nullptr ? *o.outputs : own_outputs;
+  outputs.create_directories(o.out_dir);
   RowEstimator estimator(ContactEstimator(model, geometry, estimator_options), model.nq());
-  EstimatesWriter writer(o.out_dir / "estimates.csv", model);
+  const std::filesystem::path estimates = o.out_dir / "estimates.csv";
+  EstimatesWriter writer(outputs.stage(estimates), model);
   WindowMetrics metrics(o.windows);
   std::optional<detail::FigureRecorder> figures;
   if (o.figures) figures.emplace(model, layout.truth, o.plot_points);
@@ -150,6 +159,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   pipeline.finish();
   writer.close();
   if (span.rows == 0) throw Error(log_name + ": the log has a header but no rows");
+  outputs.commit(estimates);
 
   ReplayResult result;
   result.rows = span.rows;
@@ -157,12 +167,20 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   result.report = report_of(o, span);
   if (layout.truth) {
     result.report.windows = metrics.result();
-    write_metrics_json(o.out_dir / "metrics.json", result.report);
+    const std::filesystem::path json = o.out_dir / "metrics.json";
+    write_metrics_json(outputs.stage(json), result.report);
+    outputs.commit(json);
   }
   if (o.figures) {
     result.figures =
         figures->draw({o.out_dir, title, o.snapshots, estimator_options.sensor.pose.translation});
+    outputs.adopt(o.out_dir / "plot_data.txt");
+    for (const auto& png : result.figures) {
+      outputs.adopt(png);
+      outputs.adopt(std::filesystem::path(png).replace_extension(".gp"));
+    }
   }
+  own_outputs.keep();
   return result;
 }
 

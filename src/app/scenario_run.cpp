@@ -17,19 +17,45 @@
 namespace extwrench {
 namespace {
 
-// Every scheme's configuration file, written and read back before the simulation, so that a bad
-// scheme fails first.
+// Every scheme checked before anything is written: its configuration as it will be written,
+// with the scenario's own robot in place of the seed's perturbed copy (same links and joints).
+void check_schemes(const Scenario& s, const std::filesystem::path& first_dir) {
+  const std::string robot = std::filesystem::absolute(s.robot_path).lexically_normal().string();
+  std::string quoted = "\"";
+  for (const char c : robot)
+    quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+  quoted += "\"";
+  for (const SchemeSpec& scheme : s.schemes) {
+    std::string text = scheme_config_yaml(s, scheme);
+    const std::string kRobot = "robot: ../model_estimator.urdf\n";
+    if (const auto at = text.find(kRobot); at != std::string::npos)
+      text.replace(at, kRobot.size(), "robot: " + quoted + "\n");
+    try {
+      (void)load_estimator_config_string(text, first_dir / scheme.name / "config.yaml");
+    } catch (const Error& e) {
+      throw Error(s.source.string() + ":" + std::to_string(scheme.line) + ": scheme '" +
+                  scheme.name + "': " + e.what());
+    }
+  }
+}
+
+// Every scheme's configuration file, written and read back before the simulation.
 std::vector<EstimatorConfig> write_scheme_configs(const Scenario& s,
-                                                  const std::filesystem::path& dir) {
+                                                  const std::filesystem::path& dir,
+                                                  OutputFiles& outputs) {
   std::vector<EstimatorConfig> configs;
   for (const SchemeSpec& scheme : s.schemes) {
-    std::filesystem::create_directories(dir / scheme.name);
+    outputs.create_directories(dir / scheme.name);
     const std::filesystem::path cfg = dir / scheme.name / "config.yaml";
     {
-      std::ofstream out(cfg);
-      if (!out) throw Error(cfg.string() + ": cannot create the file");
+      const std::filesystem::path partial = outputs.stage(cfg);
+      std::ofstream out(partial);
+      if (!out) throw Error(partial.string() + ": cannot create the file");
       out << scheme_config_yaml(s, scheme);
+      out.flush();
+      if (!out) throw Error(partial.string() + ": write failed (disk full?)");
     }
+    outputs.commit(cfg);
     try {
       configs.push_back(load_estimator_config(cfg));
     } catch (const Error& e) {
@@ -43,7 +69,7 @@ std::vector<EstimatorConfig> write_scheme_configs(const Scenario& s,
 // The closed-loop simulation of one seed into r.dir/log.csv, with the estimator's (believed)
 // model in the controller; counts the samples and tracks the peak of cond(J of O_l) at the true q.
 void simulate_seed(const Scenario& s, const Model& believed, int singular_body, bool progress_on,
-                   SeedResult& r) {
+                   OutputFiles& outputs, SeedResult& r) {
   const Model& model = s.robot.model;
   sim::SimulationConfig sc = s.simulation;
   sc.noise_seed = 2 * r.seed + 1;
@@ -56,7 +82,8 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   layout.moment = sc.sensor.type == SensorType::kForceTorque;
   layout.truth = true;
   layout.true_tau_ext = true;
-  LogWriter log(r.dir / "log.csv", layout);
+  const std::filesystem::path log_path = r.dir / "log.csv";
+  LogWriter log(outputs.stage(log_path), layout);
   Sample sample;
   Data data(model);
   const long total = simulator.num_samples();
@@ -78,6 +105,7 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   }
   progress.done();
   log.close();
+  outputs.commit(log_path);
 }
 
 // The metric windows: after the residual's transient, and also outside the singularity when the
@@ -108,7 +136,7 @@ std::vector<ReplayWindow> metric_windows(const Scenario& s, const SeedResult& r,
 // Every scheme replayed on the seed's log.
 void replay_schemes(const Scenario& s, const std::vector<EstimatorConfig>& configs,
                     const std::vector<ReplayWindow>& windows, const RunOptions& options,
-                    SeedResult& r) {
+                    OutputFiles& outputs, SeedResult& r) {
   for (std::size_t i = 0; i < s.schemes.size(); ++i) {
     ReplayOptions ro;
     ro.log = r.dir / "log.csv";
@@ -120,6 +148,7 @@ void replay_schemes(const Scenario& s, const std::vector<EstimatorConfig>& confi
     ro.figures = options.figures && s.figures;
     ro.progress = options.progress;
     ro.warn_ignored_columns = false;
+    ro.outputs = &outputs;
     // Straight from the files just written, like `extwrench estimate`: nothing else is shared.
     const EstimatorConfig& cfg = configs[i];
     r.schemes.push_back(
@@ -127,18 +156,25 @@ void replay_schemes(const Scenario& s, const std::vector<EstimatorConfig>& confi
   }
 }
 
+std::filesystem::path seed_dir(const Scenario& s, std::uint64_t seed,
+                               const std::filesystem::path& out_dir) {
+  return s.seeds.size() == 1 ? out_dir : out_dir / ("seed_" + std::to_string(seed));
+}
+
 SeedResult run_seed(const Scenario& s, std::uint64_t seed, const std::filesystem::path& out_dir,
-                    const RunOptions& options, int singular_body) {
+                    const RunOptions& options, int singular_body, OutputFiles& outputs) {
   SeedResult r;
   r.seed = seed;
-  r.dir = s.seeds.size() == 1 ? out_dir : out_dir / ("seed_" + std::to_string(seed));
-  std::filesystem::create_directories(r.dir);
+  r.dir = seed_dir(s, seed, out_dir);
+  outputs.create_directories(r.dir);
   // Two independent streams per seed: the model error and the sensor noise.
   const Model believed = sim::perturb_model(s.robot.model, s.model_error, 2 * seed);
-  write_urdf(r.dir / "model_estimator.urdf", believed, s.robot.geometry);
-  const std::vector<EstimatorConfig> configs = write_scheme_configs(s, r.dir);
-  simulate_seed(s, believed, singular_body, options.progress, r);
-  replay_schemes(s, configs, metric_windows(s, r, singular_body), options, r);
+  const std::filesystem::path urdf = r.dir / "model_estimator.urdf";
+  write_urdf(outputs.stage(urdf), believed, s.robot.geometry);
+  outputs.commit(urdf);
+  const std::vector<EstimatorConfig> configs = write_scheme_configs(s, r.dir, outputs);
+  simulate_seed(s, believed, singular_body, options.progress, outputs, r);
+  replay_schemes(s, configs, metric_windows(s, r, singular_body), options, outputs, r);
   return r;
 }
 
@@ -148,9 +184,13 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
                                      const RunOptions& options) {
   const Model& model = s.robot.model;
   const int singular_body = s.singularity_link.empty() ? -1 : *model.find_body(s.singularity_link);
+  if (!s.seeds.empty()) check_schemes(s, seed_dir(s, s.seeds.front(), out_dir));
+  // One transaction for the whole run: a failure in any seed leaves none of the run's files.
+  OutputFiles outputs;
   std::vector<SeedResult> results;
   for (const std::uint64_t seed : s.seeds)
-    results.push_back(run_seed(s, seed, out_dir, options, singular_body));
+    results.push_back(run_seed(s, seed, out_dir, options, singular_body, outputs));
+  outputs.keep();
   return results;
 }
 

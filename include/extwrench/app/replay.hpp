@@ -11,6 +11,7 @@
 
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/metrics_json.hpp"
+#include "extwrench/io/output_files.hpp"
 
 namespace extwrench {
 
@@ -33,6 +34,9 @@ struct ReplayOptions {
   int snapshots = 4;                 ///< instants of the 3-D view
   bool progress = false;             ///< progress line on stderr
   bool warn_ignored_columns = true;  ///< list unknown log columns once on stderr
+  /// The command's output transaction (a scenario run's); null: the replay is its own, kept
+  /// when it succeeds. Either way a failed replay leaves no estimates.csv or metrics.json.
+  OutputFiles* outputs = nullptr;
 };
 
 struct ReplayResult {
@@ -47,7 +51,8 @@ struct ReplayResult {
 /// figures (PNG, gnuplot) unless disabled. The first row resets the estimator (its output row is
 /// "free" with a zero residual). Throws extwrench::Error on malformed logs (file, line, column)
 /// and when the log lacks the columns the configuration's sensor needs; a malformed row fails
-/// after every row before it was estimated and written, as in a row-by-row loop.
+/// after every row before it was estimated, and leaves no output (estimates.csv is written as
+/// estimates.csv.partial and renamed at the end; see OutputFiles).
 ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator, const ReplayOptions& options);
 

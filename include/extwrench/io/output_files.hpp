@@ -1,0 +1,42 @@
+// The files a command writes, as one transaction: each file is written to "<name>.partial" in
+// its final directory and renamed to its name when complete; when the command fails (the
+// object is destroyed without keep()), every file and directory it created is removed again,
+// so a failed command leaves nothing that looks like a result (docs/cli.md "Outputs").
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+namespace extwrench {
+
+class OutputFiles {
+ public:
+  OutputFiles() = default;
+  /// Rolls back unless keep() was called: removes staged and committed files, then the
+  /// directories create_directories() made (when empty). Never throws.
+  ~OutputFiles();
+  OutputFiles(const OutputFiles&) = delete;
+  OutputFiles& operator=(const OutputFiles&) = delete;
+
+  /// Creates `dir` and its missing parents, remembering the ones it made.
+  void create_directories(const std::filesystem::path& dir);
+  /// The name to write `path` under until commit(path): "<path>.partial".
+  std::filesystem::path stage(const std::filesystem::path& path);
+  /// The staged file of `path` is complete: renames it to `path` (atomic, same directory).
+  void commit(const std::filesystem::path& path);
+  /// Registers a file written directly under its name (figures), to remove on rollback.
+  void adopt(const std::filesystem::path& path);
+  /// The command succeeded: keep every file.
+  void keep() { kept_ = true; }
+
+  /// "<path>.partial".
+  static std::filesystem::path partial_name(const std::filesystem::path& path);
+
+ private:
+  std::vector<std::filesystem::path> staged_;
+  std::vector<std::filesystem::path> committed_;
+  std::vector<std::filesystem::path> directories_;
+  bool kept_ = false;
+};
+
+}  // namespace extwrench

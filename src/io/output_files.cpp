@@ -1,0 +1,56 @@
+#include "extwrench/io/output_files.hpp"
+
+#include <algorithm>
+#include <system_error>
+
+#include "extwrench/core/error.hpp"
+
+namespace extwrench {
+
+namespace fs = std::filesystem;
+
+OutputFiles::~OutputFiles() {
+  if (kept_) return;
+  std::error_code ec;
+  for (const fs::path& p : staged_) fs::remove(partial_name(p), ec);
+  for (const fs::path& p : committed_) fs::remove(p, ec);
+  // Deepest first; a directory holding files that are not ours stays.
+  for (auto d = directories_.rbegin(); d != directories_.rend(); ++d) fs::remove(*d, ec);
+}
+
+void OutputFiles::create_directories(const fs::path& dir) {
+  std::vector<fs::path> missing;
+  std::error_code ec;
+  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
+    missing.push_back(p);
+    if (p == p.parent_path()) break;
+  }
+  fs::create_directories(dir, ec);
+  if (ec) throw Error(dir.string() + ": cannot create the directory: " + ec.message());
+  directories_.insert(directories_.end(), missing.rbegin(), missing.rend());
+}
+
+fs::path OutputFiles::partial_name(const fs::path& path) {
+  fs::path p = path;
+  p += ".partial";
+  return p;
+}
+
+fs::path OutputFiles::stage(const fs::path& path) {
+  staged_.push_back(path);
+  return partial_name(path);
+}
+
+void OutputFiles::commit(const fs::path& path) {
+  const auto it = std::find(staged_.begin(), staged_.end(), path);
+  if (it == staged_.end()) throw Error(path.string() + ": committed but never staged");
+  std::error_code ec;
+  fs::rename(partial_name(path), path, ec);
+  if (ec) throw Error(path.string() + ": cannot rename the finished file: " + ec.message());
+  staged_.erase(it);
+  committed_.push_back(path);
+}
+
+void OutputFiles::adopt(const fs::path& path) { committed_.push_back(path); }
+
+}  // namespace extwrench
