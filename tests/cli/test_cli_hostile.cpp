@@ -1,0 +1,338 @@
+// Hostile inputs through the binary (issue 14): a 10 000-joint chain, endless and odd files
+// (/dev/zero, FIFOs, directories) as configuration, scenario, log and mesh, failed commands
+// leaving no output, and messages that name the file. Large inputs are generated here.
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/io/log.hpp"
+#include "extwrench/model/model_builder.hpp"
+
+namespace extwrench {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kPaperArm = fs::path(EXTWRENCH_SOURCE_DIR) / "models" / "paper_arm.urdf";
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+struct CliRun {
+  int code = -1;
+  std::string err;
+  double seconds = 0.0;
+  long peak_rss_kb = 0;
+};
+
+// EXTWRENCH_HOSTILE_CLI=<binary> runs these checks against another build (e.g. one from before
+// the fixes, to see them fail).
+const char* cli_binary() {
+  const char* other = std::getenv("EXTWRENCH_HOSTILE_CLI");
+  return other != nullptr ? other : EXTWRENCH_CLI;
+}
+
+class Hostile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("extwrench_hostile_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs `sh -c "<prefix> exec extwrench <args>"` under `timeout 20` (a FIFO must not hang the
+  // suite), measuring wall time and the child's peak RSS.
+  CliRun run(const std::string& args, const std::string& prefix = "") const {
+    const fs::path err = dir_ / "stderr.txt";
+    const std::string command = prefix + " exec timeout 20 '" + cli_binary() + "' " + args +
+                                " >/dev/null 2>'" + err.string() + "' </dev/null";
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = fork();
+    if (pid == 0) {
+      execl("/bin/sh", "sh", "-c", command.c_str(), nullptr);
+      _exit(127);
+    }
+    int status = 0;
+    struct rusage usage {};
+    wait4(pid, &status, 0, &usage);
+    CliRun r;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.peak_rss_kb = usage.ru_maxrss;
+    r.err = read_text(err);
+    return r;
+  }
+  fs::path path(const std::string& name) const { return dir_ / name; }
+  std::string q(const fs::path& p) const { return "'" + p.string() + "'"; }
+  // Files in `dir` (recursively), as "a, b/c".
+  static std::string listing(const fs::path& dir) {
+    std::string out;
+    std::error_code ec;
+    if (!fs::exists(dir, ec)) return "(no directory)";
+    for (const auto& e : fs::recursive_directory_iterator(dir))
+      out += (out.empty() ? "" : ", ") + fs::relative(e.path(), dir).string();
+    return out;
+  }
+
+  fs::path dir_;
+};
+
+::testing::AssertionResult contains(const std::string& text, const std::string& needle) {
+  if (text.find(needle) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << needle << "'";
+}
+
+// A serial chain of `n` revolute joints, each link with mass and inertia.
+std::string chain_urdf(int n) {
+  std::string s = "<robot name=\"chain\">\n";
+  const auto link = [&](int i) {
+    s += "<link name=\"l" + std::to_string(i) +
+         "\"><inertial><origin xyz=\"0 0 0.05\"/><mass value=\"0.1\"/><inertia ixx=\"1e-4\" "
+         "ixy=\"0\" ixz=\"0\" iyy=\"1e-4\" iyz=\"0\" izz=\"1e-4\"/></inertial></link>\n";
+  };
+  link(0);
+  for (int i = 1; i <= n; ++i) {
+    link(i);
+    s += "<joint name=\"j" + std::to_string(i) + "\" type=\"revolute\"><parent link=\"l" +
+         std::to_string(i - 1) + "\"/><child link=\"l" + std::to_string(i) +
+         "\"/><origin xyz=\"0 0 0.1\"/><axis xyz=\"" + (i % 2 ? "0 0 1" : "0 1 0") +
+         "\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/></joint>\n";
+  }
+  return s + "</robot>\n";
+}
+
+// ---- item 2: linear-time model building, documented limits ----------------------------------
+
+TEST_F(Hostile, InfoOnATenThousandJointChainTakesUnderASecondAnd200MB) {
+  write_text(path("chain.urdf"), chain_urdf(10'000));
+  const CliRun r = run("info " + q(path("chain.urdf")));
+  std::printf("info, 10000 joints: %.3f s, peak RSS %ld KiB\n", r.seconds, r.peak_rss_kb);
+  RecordProperty("seconds", std::to_string(r.seconds));
+  RecordProperty("peak_rss_kb", std::to_string(r.peak_rss_kb));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_LT(r.seconds, 1.0);
+  EXPECT_LT(r.peak_rss_kb, 200 * 1024);
+}
+
+TEST_F(Hostile, AMasslessLeafOfALongChainIsStillRefusedNamingItsJoint) {
+  std::string urdf = chain_urdf(2'000);
+  const std::string last = "<link name=\"l2000\">";
+  const auto at = urdf.find(last);
+  urdf.replace(at, urdf.find("</link>", at) + 7 - at, "<link name=\"l2000\"/>");
+  write_text(path("chain.urdf"), urdf);
+  const CliRun r = run("info " + q(path("chain.urdf")));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, "joint 'j2000'"));
+  EXPECT_TRUE(contains(r.err, "not positive definite"));
+}
+
+TEST_F(Hostile, MoreLinksThanTheLimitAreRefused) {
+  ModelBuilder b;
+  for (std::size_t i = 0; i <= kMaxLinks; ++i) {
+    LinkSpec l;
+    l.name = std::to_string(i);
+    b.add_link(l);
+  }
+  try {
+    (void)b.build();
+    FAIL() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(e.what(), "100001 links and 0 joints, more than the limit of 100000"));
+  }
+}
+
+// ---- item 3: one way to open an input -------------------------------------------------------
+
+TEST_F(Hostile, EndlessOrOddFilesAsConfigurationAreRefusedAtOnce) {
+  ASSERT_EQ(mkfifo(path("fifo").c_str(), 0600), 0);
+  fs::create_directories(path("dir"));
+  write_text(path("log.csv"), "t\n0\n");
+  const std::string rest = " --log " + q(path("log.csv")) + " --out " + q(path("out"));
+  const CliRun zero = run("estimate --config /dev/zero" + rest);
+  EXPECT_EQ(zero.code, 1);
+  EXPECT_TRUE(contains(zero.err,
+                       "/dev/zero: the configuration file is not a regular file (a "
+                       "character device)"));
+  const CliRun fifo = run("estimate --config " + q(path("fifo")) + rest);
+  EXPECT_EQ(fifo.code, 1) << "a FIFO blocked (timeout) or was read: " << fifo.err;
+  EXPECT_TRUE(contains(fifo.err, "fifo: the configuration file is not a regular file (a FIFO"));
+  EXPECT_LT(fifo.seconds, 5.0);
+  const CliRun dir = run("estimate --config " + q(path("dir")) + rest);
+  EXPECT_TRUE(contains(dir.err, "dir: the configuration file is a directory"));
+  EXPECT_FALSE(fs::exists(path("out")));
+}
+
+TEST_F(Hostile, ADirectoryOrFifoAsScenarioOrLogIsNamedForWhatItIs) {
+  ASSERT_EQ(mkfifo(path("fifo").c_str(), 0600), 0);
+  fs::create_directories(path("dir"));
+  const CliRun scenario = run("simulate " + q(path("dir")) + " --out " + q(path("out")));
+  EXPECT_EQ(scenario.code, 1);
+  EXPECT_TRUE(contains(scenario.err, "dir: the scenario file is a directory"));
+  EXPECT_EQ(scenario.err.find("basic_filebuf"), std::string::npos) << scenario.err;
+  write_text(path("config.yaml"), "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  for (const char* log : {"dir", "fifo"}) {
+    const CliRun r = run("estimate --config " + q(path("config.yaml")) + " --log " + q(path(log)) +
+                         " --out " + q(path("out")));
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(r.err.find("no such log file"), std::string::npos) << r.err;
+    EXPECT_TRUE(contains(r.err, std::string(log) + ": the log file is "));
+  }
+}
+
+TEST_F(Hostile, AMeshThatIsADirectoryOrADeviceIsNamedForWhatItIs) {
+  fs::create_directories(path("mesh_dir"));
+  std::string urdf = read_text(kPaperArm);
+  const std::string link = "<link name=\"link6\">";
+  const auto at = urdf.find(link);
+  ASSERT_NE(at, std::string::npos);
+  for (const std::string& mesh : {path("mesh_dir").string(), std::string("/dev/zero")}) {
+    std::string u = urdf;
+    u.insert(at + link.size(),
+             "<collision><geometry><mesh filename=\"" + mesh + "\"/></geometry></collision>");
+    write_text(path("robot.urdf"), u);
+    const CliRun r = run("info " + q(path("robot.urdf")));
+    EXPECT_EQ(r.code, 1);
+    EXPECT_EQ(r.err.find("not found"), std::string::npos) << r.err;
+    EXPECT_TRUE(contains(r.err, mesh + ": the mesh file is "));
+  }
+}
+
+// ---- item 5: a failed command leaves nothing that looks whole ---------------------------------
+
+void write_log(const fs::path& path, long rows) {
+  LogLayout layout{.n = 7, .velocity = true, .force = true, .moment = true};
+  LogWriter w(path, layout);
+  sim::Sample s;
+  s.q = VectorX::Constant(7, 0.1);
+  s.dq = VectorX::Zero(7);
+  s.tau = VectorX::Constant(7, 1.0);
+  s.sensor << 1, 2, -170, 0.1, 0.2, 0.3;
+  for (long k = 0; k < rows; ++k) {
+    s.t = 0.001 * static_cast<double>(k);
+    w.write(s);
+  }
+  w.close();
+}
+
+TEST_F(Hostile, EstimateFailingOnALateRowLeavesNoEstimates) {
+  write_log(path("log.csv"), 50'000);
+  std::ofstream(path("log.csv"), std::ios::app) << "oops\n";
+  write_text(path("config.yaml"), "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  const CliRun r = run("estimate --no-figures --config " + q(path("config.yaml")) + " --log " +
+                       q(path("log.csv")) + " --out " + q(path("out")));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, "log.csv:50002:"));
+  EXPECT_EQ(listing(path("out")), "(no directory)");
+}
+
+TEST_F(Hostile, AFullDiskDuringEstimateOrSimulateLeavesNoTruncatedFile) {
+  // RLIMIT_FSIZE stands for a full disk: writes past 1 MiB fail (SIGXFSZ ignored).
+  const std::string full = "ulimit -f 1024; trap '' XFSZ;";
+  write_log(path("log.csv"), 50'000);
+  write_text(path("config.yaml"), "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  const CliRun e = run("estimate --no-figures --config " + q(path("config.yaml")) + " --log " +
+                           q(path("log.csv")) + " --out " + q(path("est")),
+                       full);
+  EXPECT_EQ(e.code, 1) << e.err;
+  EXPECT_TRUE(contains(e.err, "write failed"));
+  EXPECT_EQ(listing(path("est")), "(no directory)");
+  write_text(path("s.yaml"), "robot: " + kPaperArm.string() +
+                                 "\nseeds: [1]\nduration: 3\ntrajectory: {offset: 0.3, "
+                                 "amplitude: 0.2, frequency: 0.5, phase: 0}\nschemes:\n  ft: "
+                                 "{sensor: {type: ft}}\n");
+  const CliRun s =
+      run("simulate --no-figures " + q(path("s.yaml")) + " --out " + q(path("sim")), full);
+  EXPECT_EQ(s.code, 1) << s.err;
+  EXPECT_TRUE(contains(s.err, "write failed"));
+  EXPECT_EQ(listing(path("sim")), "(no directory)");
+}
+
+TEST_F(Hostile, AnInvalidSchemeIsRejectedBeforeAnythingIsWritten) {
+  write_text(path("s.yaml"), "robot: " + kPaperArm.string() +
+                                 "\nseeds: [1]\nduration: 0.2\ntrajectory: {offset: 0.3, "
+                                 "amplitude: 0.2, frequency: 0.5, phase: 0}\nschemes:\n  ft: "
+                                 "{sensor: {type: ft}}\n  bad: {sensor: {type: ft}, "
+                                 "contact: {model: magic}}\n");
+  const CliRun r = run("simulate --no-figures " + q(path("s.yaml")) + " --out " + q(path("sim")));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, "scheme 'bad'"));
+  EXPECT_TRUE(contains(r.err, "contact.model"));
+  EXPECT_EQ(listing(path("sim")), "(no directory)");
+}
+
+// ---- item 6: messages that name the file ------------------------------------------------------
+
+TEST_F(Hostile, YamlOfAnUnexpectedKindIsReportedWithFileLineAndKey) {
+  write_text(path("config.yaml"), "[a, b]: 1\nrobot: x\n");
+  write_text(path("log.csv"), "t\n0\n");
+  const CliRun c = run("estimate --config " + q(path("config.yaml")) + " --log " +
+                       q(path("log.csv")) + " --out " + q(path("out")));
+  EXPECT_EQ(c.code, 1);
+  EXPECT_TRUE(contains(c.err, path("config.yaml").string() + ":1: (top level): a key must be a "
+                                                             "name, got a list"));
+  write_text(path("s.yaml"), "robot: " + kPaperArm.string() +
+                                 "\nseeds: [1]\nduration: 0.2\ntrajectory: {offset: 0.3, "
+                                 "amplitude: 0.2, frequency: 0.5, phase: 0}\nschemes:\n  ft: "
+                                 "{sensor: ft}\n");
+  const CliRun s = run("simulate --no-figures " + q(path("s.yaml")) + " --out " + q(path("sim")));
+  EXPECT_EQ(s.code, 1);
+  EXPECT_TRUE(contains(s.err, path("s.yaml").string() + ":6: schemes.ft.sensor: expected a "
+                                                        "mapping"));
+  EXPECT_EQ(s.err.find("operator[]"), std::string::npos) << s.err;
+}
+
+TEST_F(Hostile, ARobotWithoutLinksNamesTheFileAndEscapesItsName) {
+  write_text(path("r.urdf"), "<robot name=\"x\x01\xff\">\n</robot>\n");
+  const CliRun r = run("info " + q(path("r.urdf")));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, path("r.urdf").string() + ":1: <robot 'x\\x01\\xff'>: no <link> "
+                                                        "elements"));
+}
+
+TEST_F(Hostile, TenThousandUnknownColumnsMakeAShortNote) {
+  std::string header = "t";
+  std::string row = "0";
+  for (int i = 0; i < 10'000; ++i) {
+    header += ",extra_column_" + std::to_string(i);
+    row += ",0";
+  }
+  write_log(path("base.csv"), 1);
+  // The log's own columns, then the unknown ones.
+  std::string base = read_text(path("base.csv"));
+  const auto eol = base.find('\n');
+  write_text(path("log.csv"), base.substr(0, eol) + header.substr(1) + "\n" +
+                                  base.substr(eol + 1, base.size() - eol - 2) + row.substr(1) +
+                                  "\n");
+  write_text(path("config.yaml"), "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  const CliRun r = run("estimate --no-figures --config " + q(path("config.yaml")) + " --log " +
+                       q(path("log.csv")) + " --out " + q(path("out")));
+  EXPECT_EQ(r.code, 0) << r.err.substr(0, 500);
+  EXPECT_TRUE(contains(r.err, "extra_column_9 and 9990 more")) << r.err.substr(0, 500);
+  EXPECT_LT(r.err.size(), 2000u);
+}
+
+}  // namespace
+}  // namespace extwrench
