@@ -85,11 +85,26 @@ Matrix6 motion_parent_to_body(const Pose& X_PB) {
 // massless leaf). Each pivot is judged against its own joint's diagonal entry M_ii =
 // S_i^T I^C_i S_i (composite inertia: the subtree rigid), the inertia it has when the joints
 // below are locked: a long chain's tip is then as well judged as its root, where one global
-// scale would grow as n^3 and reject it. Kept here (and not borrowed from dynamics/) so that validation does not
-// depend on the algorithms it guards.
-int singular_mass_matrix_body(const Model& model) {
+// scale would grow as n^3 and reject it. Kept here (and not borrowed from dynamics/) so that
+// validation does not depend on the algorithms it guards.
+struct SingularJoint {
+  int body = -1;       ///< -1: M(0) is positive definite
+  double ratio = 0.0;  ///< D_i / M_ii (0 or NaN: nothing at all moves with the joint)
+};
+
+// Why M(0) is singular at `s`, for messages: nothing moves with the joint, or (a very long
+// chain) so little against what it carries that M(0) is numerically singular.
+std::string why_singular(const SingularJoint& s, const char* nothing) {
+  if (!(s.ratio > 0.0)) return nothing;
+  return "the links this joint moves have " + num(s.ratio) +
+         " of their locked inertia about its axis with the joints below free (< " +
+         num(kMassMatrixRelTol) + ": M(0) is numerically singular, condition number > " +
+         num(1.0 / kMassMatrixRelTol) + ")";
+}
+
+SingularJoint singular_mass_matrix_body(const Model& model) {
   const int nb = model.num_bodies();
-  if (model.nq() == 0) return -1;
+  if (model.nq() == 0) return {};
   std::vector<Matrix6> IA(static_cast<std::size_t>(nb));
   std::vector<Matrix6> IC(static_cast<std::size_t>(nb));
   std::vector<Vector6> S(static_cast<std::size_t>(nb), Vector6::Zero());
@@ -110,12 +125,12 @@ int singular_mass_matrix_body(const Model& model) {
     const Vector6 U = IA[ui] * S[ui];
     const double D = S[ui].dot(U);
     const double M_ii = S[ui].dot(IC[ui] * S[ui]);
-    if (!std::isfinite(M_ii) || !(D > kMassMatrixRelTol * M_ii)) return i;
+    if (!std::isfinite(M_ii) || !(D > kMassMatrixRelTol * M_ii)) return {i, D / M_ii};
     IC[static_cast<std::size_t>(model.parents[ui])] += X.transpose() * IC[ui] * X;
     const Matrix6 Ia = IA[ui] - U * U.transpose() / D;
     IA[static_cast<std::size_t>(model.parents[ui])] += X.transpose() * Ia * X;
   }
-  return -1;
+  return {};
 }
 
 }  // namespace
@@ -197,13 +212,15 @@ void validate_model(const Model& model) {
     if (!finite(f.placement))
       throw Error(p + "frame '" + f.name + "': placement: expected finite numbers");
   }
-  const int bad = singular_mass_matrix_body(model);
-  if (bad > 0) {
-    const auto ub = static_cast<std::size_t>(bad);
-    throw Error(
-        p + "joint '" + model.joints[ub].name + "' (body '" + model.bodies[ub].name +
-        "'): the joint-space mass matrix is not positive definite at q = 0 (the bodies this "
-        "joint moves carry no mass or inertia about its axis)");
+  const SingularJoint bad = singular_mass_matrix_body(model);
+  if (bad.body > 0) {
+    const auto ub = static_cast<std::size_t>(bad.body);
+    throw Error(p + "joint '" + model.joints[ub].name + "' (body '" + model.bodies[ub].name +
+                "'): the joint-space mass matrix is not positive definite at q = 0 (" +
+                why_singular(bad,
+                             "the bodies this joint moves carry no mass or inertia about "
+                             "its axis") +
+                ")");
   }
 }
 
@@ -427,13 +444,13 @@ void ModelBuilder::add_extra_frames(Model& model) const {
 // --- a massless body is fine only if M(q = 0) stays positive definite
 void ModelBuilder::check_massless_bodies(const Model& model,
                                          const std::vector<std::string>& body_source) {
-  const int bad = singular_mass_matrix_body(model);
-  if (bad > 0) {
-    throw Error(
-        body_source[static_cast<std::size_t>(bad)] +
-        ": the joint-space mass matrix is not positive definite at q = 0: the links this joint "
-        "moves carry no mass or inertia about its axis (give the child link an <inertial>, or "
-        "make the joint fixed)");
+  const SingularJoint bad = singular_mass_matrix_body(model);
+  if (bad.body > 0) {
+    throw Error(body_source[static_cast<std::size_t>(bad.body)] +
+                ": the joint-space mass matrix is not positive definite at q = 0: " +
+                why_singular(bad,
+                             "the links this joint moves carry no mass or inertia about its axis "
+                             "(give the child link an <inertial>, or make the joint fixed)"));
   }
 }
 

@@ -137,6 +137,18 @@ TEST_F(Hostile, InfoOnATenThousandJointChainTakesUnderASecondAnd200MB) {
   EXPECT_LT(r.peak_rss_kb, 200 * 1024);
 }
 
+TEST_F(Hostile, AFiftyThousandJointChainIsRefusedWithinTheSameBoundsPerJoint) {
+  // Its M(0) has a condition number above 1e12 (the check's tolerance, as before): refused,
+  // saying so, in the time and memory per joint of the 10 000-joint chain.
+  write_text(path("chain.urdf"), chain_urdf(50'000));
+  const CliRun r = run("info " + q(path("chain.urdf")));
+  std::printf("info, 50000 joints: %.3f s, peak RSS %ld KiB\n", r.seconds, r.peak_rss_kb);
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, "M(0) is numerically singular, condition number > 1e+12"));
+  EXPECT_LT(r.seconds, 5.0);
+  EXPECT_LT(r.peak_rss_kb, 5 * 200 * 1024);
+}
+
 TEST_F(Hostile, AMasslessLeafOfALongChainIsStillRefusedNamingItsJoint) {
   std::string urdf = chain_urdf(2'000);
   const std::string last = "<link name=\"l2000\">";
