@@ -10,6 +10,7 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/csv.hpp"
+#include "extwrench/io/output_files.hpp"
 
 namespace extwrench::cli {
 namespace {
@@ -68,46 +69,43 @@ void run_dynamics(const DynamicsOptions& opt) {
                 ", dq1..dq" + std::to_string(n) + ", ddq1..ddq" + std::to_string(n) + ")");
   }
   std::string extra;
+  std::size_t extras = 0;
+  constexpr std::size_t kShown = 10;  // a header of 10 000 stray columns must not print them all
   for (const std::string& name : reader->header()) {
-    if (std::find(wanted.begin(), wanted.end(), name) == wanted.end())
-      extra += (extra.empty() ? "" : ", ") + name;
+    if (std::find(wanted.begin(), wanted.end(), name) != wanted.end()) continue;
+    if (++extras <= kShown) extra += (extra.empty() ? "" : ", ") + name;
   }
+  if (extras > kShown) extra += " and " + std::to_string(extras - kShown) + " more";
   if (!extra.empty()) std::cerr << "extwrench dynamics: ignoring column(s) " << extra << "\n";
 
+  // OUT.csv.partial until complete: a failed run leaves nothing that looks like a result.
+  OutputFiles outputs;
+  const std::filesystem::path out_path(opt.out);
   std::unique_ptr<CsvWriter> writer =
-      opt.out == "-"
-          ? std::make_unique<CsvWriter>(std::cout, output_columns(n), "<stdout>")
-          : std::make_unique<CsvWriter>(std::filesystem::path(opt.out), output_columns(n));
+      opt.out == "-" ? std::make_unique<CsvWriter>(std::cout, output_columns(n), "<stdout>")
+                     : std::make_unique<CsvWriter>(outputs.stage(out_path), output_columns(n));
 
   Data data(model);
   VectorX q(n), dq(n), ddq(n);
   const auto at = [&](int k) { return index[static_cast<std::size_t>(k)]; };
-  try {
-    while (reader->next_row()) {
-      const double t = reader->number(at(0));
-      for (int i = 0; i < n; ++i) {
-        q[i] = reader->number(at(1 + i));
-        dq[i] = reader->number(at(1 + n + i));
-        ddq[i] = reader->number(at(1 + 2 * n + i));
-      }
-      const VectorX& tau = rnea(model, data, q, dq, ddq);
-      const Vector6 reading = sensor_reading(data, X_WS);  // [f_m; n_m] in S, about O_s (SPEC 3)
-      writer->add(t);
-      for (int i = 0; i < n; ++i) writer->add(tau[i]);
-      for (int k = 0; k < 6; ++k) writer->add(reading[k]);
-      writer->end_row();
+  while (reader->next_row()) {
+    const double t = reader->number(at(0));
+    for (int i = 0; i < n; ++i) {
+      q[i] = reader->number(at(1 + i));
+      dq[i] = reader->number(at(1 + n + i));
+      ddq[i] = reader->number(at(1 + 2 * n + i));
     }
-  } catch (const Error&) {
-    // Leave no half-written output that could be mistaken for a result.
-    writer.reset();
-    if (opt.out != "-") {
-      std::error_code ignored;
-      std::filesystem::remove(opt.out, ignored);
-    }
-    throw;
+    const VectorX& tau = rnea(model, data, q, dq, ddq);
+    const Vector6 reading = sensor_reading(data, X_WS);  // [f_m; n_m] in S, about O_s (SPEC 3)
+    writer->add(t);
+    for (int i = 0; i < n; ++i) writer->add(tau[i]);
+    for (int k = 0; k < 6; ++k) writer->add(reading[k]);
+    writer->end_row();
   }
   writer->close();
   if (opt.out != "-") {
+    outputs.commit(out_path);
+    outputs.keep();
     std::cerr << "extwrench dynamics: " << reader->rows_read() << " row(s) written to " << opt.out
               << "\n";
   }
