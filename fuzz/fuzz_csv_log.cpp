@@ -23,7 +23,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   try {
     extwrench::LogReader reader(path, model);
-    extwrench::sim::Sample sample;
+    extwrench::Sample sample;
     while (reader.next(sample)) {
     }
   } catch (const extwrench::Error&) {

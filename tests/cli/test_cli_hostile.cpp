@@ -237,7 +237,7 @@ TEST_F(Hostile, AMeshThatIsADirectoryOrADeviceIsNamedForWhatItIs) {
 void write_log(const fs::path& path, long rows) {
   LogLayout layout{.n = 7, .velocity = true, .force = true, .moment = true};
   LogWriter w(path, layout);
-  sim::Sample s;
+  Sample s;
   s.q = VectorX::Constant(7, 0.1);
   s.dq = VectorX::Zero(7);
   s.tau = VectorX::Constant(7, 1.0);
