@@ -18,6 +18,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/log.hpp"
 #include "extwrench/model/model_builder.hpp"
+#include "support/build_info.hpp"
 
 namespace extwrench {
 namespace {
@@ -133,6 +134,7 @@ TEST_F(Hostile, InfoOnATenThousandJointChainTakesUnderASecondAnd200MB) {
   RecordProperty("seconds", std::to_string(r.seconds));
   RecordProperty("peak_rss_kb", std::to_string(r.peak_rss_kb));
   ASSERT_EQ(r.code, 0) << r.err;
+  if (test::kSanitizerBuild) return;  // the bounds are the optimised build's
   EXPECT_LT(r.seconds, 1.0);
   EXPECT_LT(r.peak_rss_kb, 200 * 1024);
 }
@@ -145,6 +147,7 @@ TEST_F(Hostile, AFiftyThousandJointChainIsRefusedWithinTheSameBoundsPerJoint) {
   std::printf("info, 50000 joints: %.3f s, peak RSS %ld KiB\n", r.seconds, r.peak_rss_kb);
   EXPECT_EQ(r.code, 1);
   EXPECT_TRUE(contains(r.err, "M(0) is numerically singular, condition number > 1e+12"));
+  if (test::kSanitizerBuild) return;
   EXPECT_LT(r.seconds, 5.0);
   EXPECT_LT(r.peak_rss_kb, 5 * 200 * 1024);
 }
