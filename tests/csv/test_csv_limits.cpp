@@ -103,7 +103,9 @@ TEST(CsvLimits, AGibibyteLineIsRefusedInBoundedMemory) {
   std::printf("1 GiB line: peak RSS growth %ld KiB: %s\n", o.rss_growth_kb, o.message.c_str());
   EXPECT_EQ(o.message.rfind("gen.csv:2: line longer than 16777216 bytes", 0), 0u) << o.message;
   EXPECT_GE(o.rss_growth_kb, 0);
-  if (!test::kSanitizerBuild) EXPECT_LT(o.rss_growth_kb, kMaxGrowthKb);
+  if (!test::kSanitizerBuild) {
+    EXPECT_LT(o.rss_growth_kb, kMaxGrowthKb);
+  }
 }
 
 TEST(CsvLimits, AGibibyteOfCommasIsRefusedInBoundedMemory) {
@@ -111,14 +113,18 @@ TEST(CsvLimits, AGibibyteOfCommasIsRefusedInBoundedMemory) {
   std::printf("1 GiB of commas: peak RSS growth %ld KiB: %s\n", o.rss_growth_kb, o.message.c_str());
   EXPECT_EQ(o.message.rfind("gen.csv:2: line longer than", 0), 0u) << o.message;
   EXPECT_GE(o.rss_growth_kb, 0);
-  if (!test::kSanitizerBuild) EXPECT_LT(o.rss_growth_kb, kMaxGrowthKb);
+  if (!test::kSanitizerBuild) {
+    EXPECT_LT(o.rss_growth_kb, kMaxGrowthKb);
+  }
 }
 
 TEST(CsvLimits, TooManyColumnsAreRefusedNamingTheLine) {
   // 1 MiB of commas: within the line cap, 10 times the column cap.
   const Outcome o = read_in_child("t,q1\n1,2\n", ',', std::size_t{1} << 20);
   EXPECT_EQ(o.message, "gen.csv:3: more than 100000 columns (the limit, docs/cli.md)");
-  if (!test::kSanitizerBuild) EXPECT_LT(o.rss_growth_kb, kMaxGrowthKb);
+  if (!test::kSanitizerBuild) {
+    EXPECT_LT(o.rss_growth_kb, kMaxGrowthKb);
+  }
   const Outcome header = read_in_child("", ',', std::size_t{1} << 20);
   EXPECT_EQ(header.message, "gen.csv:1: more than 100000 columns (the limit, docs/cli.md)");
 }
