@@ -1,3 +1,4 @@
+// A property suite spanning several sources, so it keeps its own name (docs/layout.md, Tests).
 // The real-time path allocates nothing: once a Data is made, every dynamics function runs
 // without a single heap allocation. Counted by a process-wide malloc / operator new counter
 // (tests/support/alloc_counter.hpp), so std::vector growth or a stray std::string is caught

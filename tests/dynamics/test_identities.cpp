@@ -1,3 +1,4 @@
+// A property suite spanning several sources, so it keeps its own name (docs/layout.md, Tests).
 // Physical and algebraic identities of the dynamics on random serial chains and trees:
 // every algorithm checked against another path (finite differences, RNEA columns, Newton's law).
 #include <gtest/gtest.h>

@@ -4,8 +4,8 @@
 
 #include <limits>
 
-#include "estimation/test_robots.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {

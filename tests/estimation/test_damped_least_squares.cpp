@@ -7,8 +7,8 @@
 #include <Eigen/SVD>
 #include <cmath>
 
-#include "estimation/test_robots.hpp"
 #include "extwrench/estimation/damped_least_squares.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {

@@ -5,7 +5,7 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/robot_loader.hpp"
-#include "io_test_util.hpp"
+#include "support/io_test_util.hpp"
 #include "support/random.hpp"
 
 namespace extwrench {

@@ -1,3 +1,4 @@
+// A property suite spanning several sources, so it keeps its own name (docs/layout.md, Tests).
 // Every file in tests/data/malformed/ must be rejected with a message that starts with
 // "<path>:<line>:" and names the element/key and field (table-driven).
 #include <gtest/gtest.h>

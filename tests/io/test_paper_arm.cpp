@@ -1,10 +1,10 @@
+// A property suite spanning several sources, so it keeps its own name (docs/layout.md, Tests).
 // The paper's robot (SPEC section 5) ships twice: models/paper_arm.yaml (standard DH) and
 // models/paper_arm.urdf. Both must be the same robot, and both must be the SPEC's table.
 #include <gtest/gtest.h>
 
-
 #include "extwrench/io/robot_loader.hpp"
-#include "io_test_util.hpp"
+#include "support/io_test_util.hpp"
 #include "support/paper_arm_table.hpp"
 #include "support/random.hpp"
 

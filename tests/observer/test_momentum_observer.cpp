@@ -5,10 +5,10 @@
 
 #include <cmath>
 
-#include "estimation/test_robots.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/observer/momentum_observer.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <limits>
 
-#include "estimation/test_robots.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {

@@ -1,5 +1,5 @@
-// Helpers shared by the io tests: an independent forward kinematics over a Model, and DH
-// products written directly from the textbook formulas (4x4 homogeneous transforms).
+// Helpers shared by the io and reference tests: an independent forward kinematics over a Model, and
+// DH products written directly from the textbook formulas (4x4 homogeneous transforms).
 #pragma once
 
 #include <Eigen/Geometry>

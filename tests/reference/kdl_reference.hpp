@@ -13,7 +13,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "estimation/test_robots.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench::test {
 

@@ -6,11 +6,11 @@
 #include <cstring>
 #include <limits>
 
-#include "estimation/kdl_reference.hpp"
-#include "estimation/test_robots.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
+#include "reference/kdl_reference.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {

@@ -7,9 +7,9 @@
 
 #include <cmath>
 
-#include "estimation/kdl_reference.hpp"
-#include "estimation/test_robots.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
+#include "reference/kdl_reference.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {

@@ -8,9 +8,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "estimation/kdl_reference.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "reference/kdl_reference.hpp"
 
 namespace extwrench {
 namespace {
