@@ -30,6 +30,9 @@ LoadOptions no_meshes() {
 fs::path panda_dir() { return test::shared_models() / "franka_panda/urdf_example-robot-data"; }
 fs::path lwr_dir() { return test::shared_models() / "kuka_lwr4plus/urdf_flobaroid"; }
 
+#define REQUIRE_SHARED() \
+  if (!test::have_shared()) GTEST_SKIP() << "no shared models at " << test::shared_models()
+
 Pose from_kdl(const KDL::Frame& f) {
   Pose x;
   for (int r = 0; r < 3; ++r) {
