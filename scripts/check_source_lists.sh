@@ -27,6 +27,14 @@ while IFS= read -r f; do
     missing=1
   fi
 done < <(find tests -name 'test_*.cpp' -not -path 'tests/packaging/*' | sort)
+# fuzz/fuzz_<name>.cpp: <name> in the harness list of fuzz/CMakeLists.txt.
+for f in $(find fuzz -name 'fuzz_*.cpp' 2>/dev/null | sort); do
+  n=$(basename "$f" .cpp)
+  if ! grep -Eq "^foreach\(harness .*\b${n#fuzz_}\b" fuzz/CMakeLists.txt; then
+    echo "not in fuzz/CMakeLists.txt: $f"
+    missing=1
+  fi
+done
 for f in $(find tests/support -name '*.cpp' | sort); do check "$f" tests/CMakeLists.txt ".*${f#tests/}"; done
 if [ "$missing" = 0 ]; then echo "check_source_lists: every source is listed"; fi
 exit "$missing"
