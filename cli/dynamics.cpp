@@ -1,5 +1,5 @@
 // extwrench dynamics: inverse dynamics and the predicted base sensor reading for each row of a
-// CSV of states (SPEC 3).
+// CSV of states (docs/method.md#newton-euler-and-the-base-sensor).
 #include <algorithm>
 #include <iostream>
 #include <memory>
@@ -96,7 +96,7 @@ void run_dynamics(const DynamicsOptions& opt) {
       ddq[i] = reader->number(at(1 + 2 * n + i));
     }
     const VectorX& tau = rnea(model, data, q, dq, ddq);
-    const Vector6 reading = sensor_reading(data, X_WS);  // [f_m; n_m] in S, about O_s (SPEC 3)
+    const Vector6 reading = sensor_reading(data, X_WS);  // [f_m; n_m] in S, about O_s (eqs. 9–10)
     writer->add(t);
     for (int i = 0; i < n; ++i) writer->add(tau[i]);
     for (int k = 0; k < 6; ++k) writer->add(reading[k]);

@@ -363,7 +363,7 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
 }
 
 // 9. In: the link, the fit, the declared contact, data_ (X_WL). Out: with a known point, the
-// point and M̂_ext (16); else, for a declared contact, the line of action (19)–(21) and its
+// point and M̂_ext (15); else, for a declared contact, the line of action (19)–(21) and its
 // entry on the link's surface (localization.hpp).
 void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contact,
                                      std::uint32_t& flags) noexcept {

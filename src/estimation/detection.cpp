@@ -67,7 +67,7 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
     base_over_ = false;
   }
   const bool base_only = base_over_ && link < 0;
-  if (base_only) link = 0;  // a contact no joint feels is on link 0 (SPEC §2)
+  if (base_only) link = 0;  // a contact no joint feels is on link 0 (Sec. II-B)
   const bool raw = link >= 0;
 
   // Debounce both edges: the raw state must hold for min_duration before it is declared.

@@ -12,7 +12,7 @@ Model perturb_model(const Model& model, double fraction, std::uint64_t seed) {
     throw Error("perturb_model: fraction must be in [0, 0.5), got " + std::to_string(fraction));
   }
   Rng rng(seed);
-  // Additive error within ±fraction of each entry's own nominal value (SPEC 5): x (1 + u).
+  // Additive error within ±fraction of each entry's own nominal value (paper Sec. IV): x (1 + u).
   auto perturb = [&](double x) { return x * (1.0 + rng.uniform(-fraction, fraction)); };
   Model out = model;
   for (Body& body : out.bodies) {

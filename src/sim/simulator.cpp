@@ -110,7 +110,7 @@ bool Simulator::next(Sample& out) {
   out.dq = dqm_;
   out.tau = tau;
   // The truth at t_k: true acceleration under τ_k, then one RNEA pass with the external
-  // wrenches down to link 0 for the base reading (SPEC 3).
+  // wrenches down to link 0 for the base reading (eqs. 9–10).
   if (!true_acceleration(model_, config_.forces, t, q_, dq_, tau, ws_)) {
     throw Error("simulator: the mass matrix is not positive definite at t = " + std::to_string(t));
   }

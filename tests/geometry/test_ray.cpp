@@ -1,4 +1,4 @@
-// Body-level line query (SPEC §4 C, eq. 21): frames, pushing vs pulling point over several
+// Body-level line query (Table I case C, eq. 21): frames, pushing vs pulling point over several
 // shapes, misses, degenerate inputs, no allocation.
 #include <gtest/gtest.h>
 

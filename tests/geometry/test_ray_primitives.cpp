@@ -20,7 +20,7 @@ using test::SeededRng;
 
 // Hits are computed in closed form: only rounding of O(1) quantities remains.
 constexpr double kSurfaceTolerance = 1e-12;
-// The recovered contact point (SPEC: the true surface point to 1e-9).
+// The recovered contact point (docs/geometry.md, Tests: the true surface point to 1e-9 m).
 constexpr double kPointTolerance = 1e-9;
 // Normals compared with central differences of step 1e-7.
 constexpr double kNormalTolerance = 1e-5;

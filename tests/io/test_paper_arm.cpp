@@ -1,6 +1,7 @@
 // A property suite spanning several sources, so it keeps its own name (docs/layout.md, Tests).
-// The paper's robot (SPEC section 5) ships twice: models/paper_arm.yaml (standard DH) and
-// models/paper_arm.urdf. Both must be the same robot, and both must be the SPEC's table.
+// The paper's robot (paper Sec. IV, Table II) ships twice: models/paper_arm.yaml (standard DH) and
+// models/paper_arm.urdf. Both must be the same robot, and both must be the table of
+// docs/method.md#the-papers-experiment.
 #include <gtest/gtest.h>
 
 #include "extwrench/io/robot_loader.hpp"
@@ -12,7 +13,7 @@ namespace extwrench {
 namespace {
 
 constexpr double kTol = 1e-12;
-// SPEC section 5, written from the SPEC (not from the model files).
+// Table II as docs/method.md restates it, written from that table (not from the model files).
 using namespace test::paper_arm_table;
 
 RobotDescription load(const char* file) {

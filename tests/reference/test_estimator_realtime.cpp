@@ -175,8 +175,8 @@ TEST(EstimatorRealTime, AfterNaNOrInfInputsTheNextGoodSampleIsBitIdenticalToACle
   }
 }
 
-// J_6 of the paper arm is singular at q4 = 0 (SPEC §4 E): approaching it, case E stays finite,
-// bounded and flagged, and exactly there it says the wrench is not observable.
+// J_6 of the paper arm is singular at q4 = 0 (Table I case E, eq. 27): approaching it, case E stays
+// finite, bounded and flagged, and exactly there it says the wrench is not observable.
 TEST(EstimatorRealTime, NearASingularityTheEstimateStaysFiniteBoundedAndFlagged) {
   const Model model = test::paper_arm_model();
   test::KdlReference kdl(model);

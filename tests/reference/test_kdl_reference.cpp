@@ -1,5 +1,6 @@
 // extwrench's dynamics against Orocos KDL 1.5, on chains that KDL builds by itself: kdl_parser
-// reads the URDF (our parser is not involved), or KDL::Frame::DH is fed the SPEC table.
+// reads the URDF (our parser is not involved), or KDL::Frame::DH is fed the paper's table
+// (docs/method.md#the-papers-experiment).
 //
 // KDL conventions used here (checked in the KDL 1.5 sources/headers):
 //  - ChainIdSolver_RNE(chain, g): g is the gravity vector in the chain's base frame; f_ext has
@@ -109,7 +110,7 @@ struct RobotCase {
   std::string tip;        ///< chain tip; the URDF is truncated to root -> tip when `truncate`
   bool truncate;
   std::string sensor_link;  ///< sensor frame from the URDF, or empty for kArbitrarySensor
-  bool dh = false;          ///< a DH YAML, compared with the SPEC table through KDL::Frame::DH
+  bool dh = false;          ///< a DH YAML, compared with the paper's table through KDL::Frame::DH
 };
 
 const Pose kArbitrarySensor =
@@ -144,8 +145,9 @@ void build_urdf_reference(const RobotCase& c, const LoadOptions& load, Reference
   }
 }
 
-// SPEC section 5, typed in from the table (not from models/): standard DH, theta_i = q_i,
-// a_i = 0; CoM in cm and barycentric inertia in g m^2, in DH frame i.
+// The paper's arm (docs/method.md#the-papers-experiment), typed in from the table (not from
+// models/): standard DH, theta_i = q_i, a_i = 0; CoM in cm and barycentric inertia in g m^2, in DH
+// frame i.
 struct SpecLink {
   double alpha, d, mass;
   std::array<double, 3> com_cm;
@@ -324,7 +326,7 @@ void check_rnea(const Reference& ref, const Model& model, bool with_wrenches, un
     KDL::Wrenches f_ext_s(ref.sensor_chain.getNrOfSegments(), KDL::Wrench::Zero());
     for (unsigned s = 0; s < ns; ++s) f_ext_s[s + 8] = f_ext[s];
     ASSERT_GE(id_sensor.CartToJnt(qs, dqs, ddqs, f_ext_s, tau_s), 0);
-    const Vector6 reading_ref = -tau_s.data.head<6>();  // f_m = −f_0, n_m = −n_0 (SPEC 3)
+    const Vector6 reading_ref = -tau_s.data.head<6>();  // f_m = −f_0, n_m = −n_0 (eqs. 9–10)
     const double e_base = rel_err(reading, reading_ref);
     worst_base.update(e_base);
     EXPECT_LE(e_base, kTol) << "state " << k << "\nours " << reading.transpose() << "\nkdl  "

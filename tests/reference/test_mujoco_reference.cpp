@@ -268,7 +268,7 @@ void MujocoReference::run(bool with_wrenches, unsigned seed) {
     const Vector3 c = vec3(d->subtree_com + 3 * m->body_rootid[1]);
     const Vector3 f0 = vec3(d->cfrc_int + 6 + 3);
     const Vector3 n0 = vec3(d->cfrc_int + 6) + (c - X_WS_.translation).cross(f0);
-    Vector6 reading_ref;  // f_m = −f_0, n_m = −n_0, in the sensor frame (SPEC 3)
+    Vector6 reading_ref;  // f_m = −f_0, n_m = −n_0, in the sensor frame (eqs. 9–10)
     reading_ref << -(X_WS_.rotation.transpose() * f0), -(X_WS_.rotation.transpose() * n0);
     const Vector6 reading = sensor_reading(data, X_WS_);
     const double e_base = test::relative_error(reading, reading_ref);

@@ -123,7 +123,7 @@ inline std::string model_to_urdf(const Model& model) {
 }
 
 /// Each body's mass, CoM coordinates and inertia entries scaled by independent factors
-/// uniform in [1 − e, 1 + e] (SPEC §5; zero entries stay zero, symmetry kept).
+/// uniform in [1 − e, 1 + e] (paper Sec. IV; zero entries stay zero, symmetry kept).
 inline Model perturbed_model(const Model& nominal, double e, unsigned seed) {
   SeededRng rng(seed);
   Model m = nominal;

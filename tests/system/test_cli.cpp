@@ -200,7 +200,8 @@ TEST_F(Cli, InfoOnThePaperArmListsItsLinksAndTotalMass) {
     EXPECT_TRUE(contains(r.out, "  " + link + "  ")) << link;
   EXPECT_TRUE(contains(r.out, "joints: 7, serial chain"));
   EXPECT_NEAR(printed_total_mass(r.out), facts.total_mass, 1e-9 * facts.total_mass);
-  // SPEC 5: link 0 (2.0 kg), five links of 2.7 kg, 1.7 kg and 0.3 kg.
+  // Table II (docs/method.md#the-papers-experiment): link 0 (2.0 kg), five links of 2.7 kg, 1.7 kg
+  // and 0.3 kg.
   EXPECT_NEAR(printed_total_mass(r.out), 2.0 + 5 * 2.7 + 1.7 + 0.3, 1e-9);
   for (int i = 1; i <= 7; ++i) EXPECT_TRUE(contains(r.out, "  q" + std::to_string(i) + "  ")) << i;
   EXPECT_TRUE(contains(r.out, "Base sensor pose"));

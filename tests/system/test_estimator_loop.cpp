@@ -1,6 +1,6 @@
 // The estimator in the loop (acceptance 2 of issue 3): the paper arm simulated with the core's
 // forward dynamics (RK4, 1 kHz, torque held between samples), tracked by computed torque on a
-// model with ±1 % parameter errors (SPEC §5), the estimator on that same perturbed model.
+// model with ±1 % parameter errors (paper Sec. IV), the estimator on that same perturbed model.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -126,7 +126,7 @@ Vector3 tangential_force(SeededRng& rng, const Vector3& lever_dir, double magnit
 }
 
 // A constant (world-frame) force starts on a moving arm: the wrench error decays with e^{−K t}
-// (SPEC §2: ṙ = K (τ_ext − r)) and is < 1 % of ‖F‖ by 8/K s. The law holds for a constant
+// (eq. 5: ṙ = K (τ_ext − r)) and is < 1 % of ‖F‖ by 8/K s. The law holds for a constant
 // τ_ext; on a moving arm τ_ext = J(q)ᵀ F drifts and r lags it by ≈ (1/K) dτ_ext/dt. So the arm
 // is position-controlled stiffly (ω = 100 rad/s, like an industrial arm): with the soft default
 // gains (ω = 10 rad/s) the push deflects the arm over ~0.3 s, τ_ext changes with q while the

@@ -18,7 +18,7 @@ enum class ContactModel : std::uint8_t {
   kKnownPoint,  ///< known point p on a given link: estimate F_ext and M_ext
 };
 
-/// Where q̈̂ and τ̂_ext come from (SPEC §2 (a), (b)).
+/// Where q̈̂ and τ̂_ext come from (docs/method.md#acceleration-routes).
 enum class AccelerationRoute : std::uint8_t {
   kResidual,  ///< (b) τ̂_ext = r, q̈̂ = B⁻¹(τ − τ_f + r − c)
   kDifferentiation,  ///< (a) q̈̂ = low-passed difference of q̇, τ̂_ext = RNEA(q, q̇, q̈̂) + τ_f − τ

@@ -11,7 +11,7 @@
 //   5. base-sensor reading       tare, F̂_ext (11), n_m − ñ_g (13)       (base_sensor.hpp)
 //   6. detection                 thresholds, hysteresis, min_duration     (detection.hpp)
 //   7. isolation                 the contact link                         (detection.hpp)
-//   8. Table I case              (F̂, M̄) by case A–E, known point (16)   (wrench_cases.hpp)
+//   8. Table I case              (F̂, M̄) by case A–E, known point (15)   (wrench_cases.hpp)
 //   9. contact point             line of action (21) → link surface       (localization.hpp)
 // then the consistency of the wrench with τ̂_ext (wrench_cases.hpp). Damped least squares
 // (Remark 6) for D and E: damped_least_squares.hpp.

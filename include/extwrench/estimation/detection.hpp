@@ -1,4 +1,5 @@
-// Contact detection and isolation (SPEC §2): thresholds with hysteresis and a minimum duration.
+// Contact detection and isolation (Sec. II-B, docs/method.md#detection-and-isolation): thresholds
+// with hysteresis and a minimum duration.
 //
 //  - joint i is "over" when |τ̂_ext,i| > τ_min,i and stays over until |τ̂_ext,i| < ratio · τ_min,i;
 //    the base force likewise with ‖F̂_ext‖ and F_min (release level = release_ratio × on level);

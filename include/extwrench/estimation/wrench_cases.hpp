@@ -1,8 +1,8 @@
 // The cases of Table I on the isolated link l (docs/estimator.md), O_l the origin of body l's
 // frame, J_l = [J_v,l; J_ω,l] the Jacobian of O_l (6×n, zero beyond l):
 //   A  F̂ = f_m − f̃_g                                  (11)   force or F/T sensor (base_sensor.hpp)
-//   B  M̂ = n_m − ñ_g − r_{s,p} × F̂                    (16)   F/T, known point
-//   C  M̃ = n_m − r_{s,l} × F̂ − ñ_g,  r̂ = F̂ × M̃/‖F̂‖²  (17–20) F/T, pure force
+//   B  M̂ = n_m − ñ_g − r_{s,p} × F̂                    (15)   F/T, known point
+//   C  M̃ = n_m − r_{s,l} × F̂ − ñ_g,  r̂ = F̂ × M̃/‖F̂‖²  (16–20) F/T, pure force
 //   D  M̄̂ = (J_ω,lᵀ)# (τ̂_1:l − J_v,lᵀ F̂)               (26)   force sensor, rank J_ω,l = 3
 //   E  W̄ = (J_lᵀ)# τ̂_1:l                              (27)   no sensor, rank J_l = 6
 // The wrench is carried as (F̂, M̄), M̄ the moment about O_l (M̄ = M_ext + r_{l,p} × F_ext).
@@ -71,7 +71,7 @@ template <typename Jacobian>
   return fit;
 }
 
-/// Known point (16). In: the fit (ok), the point p_W, O_l. Out: M̂_ext = M̄ − r_{l,p} × F̂
+/// Known point (15). In: the fit (ok), the point p_W, O_l. Out: M̂_ext = M̄ − r_{l,p} × F̂
 /// (= n_m − ñ_g − r_{s,p} × F̂ with the F/T sensor).
 [[nodiscard]] inline Vector3 known_point_moment(const WrenchFit& fit, const Vector3& p_W,
                                                 const Vector3& O_l) noexcept {

@@ -1,4 +1,4 @@
-// metrics.json (SPEC §6): one estimator run's accuracy over stated windows.
+// metrics.json (docs/method.md#metrics): one estimator run's accuracy over stated windows.
 // The schema is documented in docs/log_format.md.
 #pragma once
 

@@ -1,4 +1,5 @@
-// The momentum residual (SPEC §2, eq. 4): a virtual sensor of the external joint torques.
+// The momentum residual (eq. 4, docs/method.md#momentum-residual): a virtual sensor of the external
+// joint torques.
 //
 //   r(t) = K [ m(t) − m(0) − ∫₀ᵗ ( τ − τ_f + Cᵀ(q,q̇) q̇ − g(q) + r ) ds ],   m = B(q) q̇   (4)
 //

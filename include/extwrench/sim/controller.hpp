@@ -1,4 +1,4 @@
-// The paper's controller (SPEC 5): feedback linearization with the (perturbed) model plus a PID
+// The paper's controller (Sec. IV): feedback linearization with the (perturbed) model plus a PID
 // stabilizing part, tracking a sinusoidal joint trajectory.
 #pragma once
 

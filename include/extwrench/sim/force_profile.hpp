@@ -48,7 +48,7 @@ struct ForceProfile {
 int evaluate_forces(std::span<const ForceProfile> profiles, double t, const Data& data,
                     std::vector<ExternalWrench>& out);
 
-/// τ_ext = Σ_k J_kᵀ W_k (SPEC 1–2) from the point Jacobians of the contacts, after
+/// τ_ext = Σ_k J_kᵀ W_k (eqs. 1–2) from the point Jacobians of the contacts, after
 /// forward_kinematics. `jacobian` is a 6×n scratch matrix. Independent of the RNEA path.
 void external_joint_torques(const Model& model, const Data& data,
                             std::span<const ExternalWrench> wrenches, Matrix6X& jacobian,

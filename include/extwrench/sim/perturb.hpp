@@ -1,5 +1,6 @@
-// Dynamic parameters corrupted by bounded random errors (SPEC 5): what the controller and the
-// estimators believe, while the simulated robot keeps the nominal ones.
+// Dynamic parameters corrupted by bounded random errors (paper Sec. IV,
+// docs/method.md#the-papers-experiment): what the controller and the estimators believe, while the
+// simulated robot keeps the nominal ones.
 #pragma once
 
 #include <cstdint>

@@ -9,8 +9,9 @@
 
 namespace extwrench::sim {
 
-/// The base sensor (SPEC 3): what the robot discharges onto it, in its own frame, moment about
-/// its origin, plus a constant bias and white Gaussian noise per axis.
+/// The base sensor (docs/method.md#newton-euler-and-the-base-sensor): what the robot discharges
+/// onto it, in its own frame, moment about its origin, plus a constant bias and white Gaussian
+/// noise per axis.
 struct BaseSensorModel {
   SensorType type = SensorType::kForceTorque;
   Pose X_WS;                               ///< pose of the sensor frame in the robot's root frame W
