@@ -4,8 +4,10 @@ JOBS ?= $(shell nproc)
 BUILD ?= build
 SANITIZE_BUILD ?= build-sanitize
 BENCH_BUILD ?= build-release
+RELEASE_BUILD ?= build-install
+PREFIX ?= /usr/local
 
-.PHONY: all build test test-sanitize demo bench install-check format clean
+.PHONY: all build test test-sanitize demo bench install format clean
 
 all: build
 
@@ -26,8 +28,18 @@ test-sanitize:
 	cd $(SANITIZE_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS)
 
-demo: build
+# The main job builds only what it runs: the CLI (not the tests, benchmarks, examples).
+demo: $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) -j $(JOBS) --target extwrench_cli
 	$(BUILD)/extwrench simulate scenarios/paper.yaml --out results/paper
+
+# A Release install (no debug information: sizes in README.md) of the libraries, headers, CLI
+# and models into PREFIX; only the installed targets are built.
+install:
+	cmake -S . -B $(RELEASE_BUILD) -DCMAKE_BUILD_TYPE=Release -DEXTWRENCH_BUILD_TESTS=OFF \
+	  -DEXTWRENCH_BUILD_EXAMPLES=OFF
+	cmake --build $(RELEASE_BUILD) -j $(JOBS)
+	cmake --install $(RELEASE_BUILD) --prefix $(PREFIX) --strip
 
 bench:
 	cmake -S . -B $(BENCH_BUILD) -DCMAKE_BUILD_TYPE=Release -DEXTWRENCH_BUILD_BENCHMARKS=ON \

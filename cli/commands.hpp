@@ -15,6 +15,7 @@
 
 #include "extwrench/core/types.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "extwrench/sim/metrics.hpp"
 
 namespace extwrench::cli {
 
@@ -46,6 +47,19 @@ void add_package_path_option(CLI::App& sub, std::vector<std::filesystem::path>& 
 /// has one (it must be on link 0), else the root link's origin, aligned with it.
 /// `description` says which, for messages.
 [[nodiscard]] Pose default_sensor_pose(const Model& model, std::string* description);
+
+/// "xyz (x, y, z) m, rpy (r, p, y) rad" of a pose, for the start-up messages.
+[[nodiscard]] std::string pose_summary(const Pose& X);
+
+/// Adds `--figure-format png|svg|pdf` to a subcommand.
+void add_figure_format_option(CLI::App& sub, std::string& format);
+
+/// The metrics table of `simulate` and `estimate` (same columns, same precision): the header,
+/// then one row per run. `outside` (the window outside the singularity) and peak_condition
+/// (NaN) may be absent: "-".
+void print_metrics_header();
+void print_metrics_row(const std::string& scheme, const std::string& seed, const sim::Metrics& m,
+                       const sim::Metrics* outside, double peak_condition);
 
 /// Number for humans: up to 10 significant digits ("17.9", "-0.0875", "1e-06").
 [[nodiscard]] std::string fmt(double value);

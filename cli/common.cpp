@@ -8,6 +8,7 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
+#include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/input_file.hpp"
 #include "extwrench/io/number_text.hpp"
 
@@ -60,19 +61,53 @@ RobotDescription load_robot_file(const std::filesystem::path& path,
 
 Pose default_sensor_pose(const Model& model, std::string* description) {
   const auto frame = model.find_frame("sensor");
-  if (!frame) {
-    if (description)
-      *description = "the root link's origin ('" + model.bodies[0].name + "'), aligned with it";
-  } else {
-    const Frame& f = model.frames[static_cast<std::size_t>(*frame)];
-    if (f.body != 0) {
-      throw Error("frame 'sensor' is attached to the moving body '" +
-                  model.bodies[static_cast<std::size_t>(f.body)].name +
-                  "', but a base sensor must be fixed to link 0; give --sensor-pose instead");
-    }
-    if (description) *description = "the model's frame 'sensor'";
+  if (frame && model.frames[static_cast<std::size_t>(*frame)].body != 0) {
+    throw Error(
+        "frame 'sensor' is attached to the moving body '" +
+        model.bodies[static_cast<std::size_t>(model.frames[static_cast<std::size_t>(*frame)].body)]
+            .name +
+        "', but a base sensor must be fixed to link 0; give --sensor-pose instead");
   }
+  if (description) *description = describe_default_sensor_pose(model);
   return extwrench::default_sensor_pose(model);  // the library's rule (estimation/base_sensor)
+}
+
+std::string pose_summary(const Pose& X) {
+  return "xyz " + fmt(X.translation) + " m, rpy " + fmt(rpy_from_rotation(X.rotation)) + " rad";
+}
+
+void add_figure_format_option(CLI::App& sub, std::string& format) {
+  sub.add_option("--figure-format", format, "Figures as png (default), svg or pdf")
+      ->type_name("FORMAT")
+      ->check(CLI::IsMember({"png", "svg", "pdf"}));
+}
+
+namespace {
+
+std::string cell(double v, const char* format) {
+  if (!std::isfinite(v)) return "-";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+}  // namespace
+
+void print_metrics_header() {
+  std::printf("%-12s %6s %10s %9s %9s %10s %10s %9s %7s %9s %12s\n", "scheme", "seed", "F RMS [N]",
+              "F max [N]", "F RMS*[N]", "line RMS", "line max", "link [%]", "missed", "false al.",
+              "peak cond");
+}
+
+void print_metrics_row(const std::string& scheme, const std::string& seed, const sim::Metrics& m,
+                       const sim::Metrics* outside, double peak_condition) {
+  std::printf("%-12s %6s %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n", scheme.c_str(),
+              seed.c_str(), cell(m.force.rms(), "%.3f").c_str(), cell(m.force.max, "%.2f").c_str(),
+              outside ? cell(outside->force.rms(), "%.3f").c_str() : "-",
+              cell(m.line.rms(), "%.4f").c_str(),
+              cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
+              cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
+              cell(peak_condition, "%.3g").c_str());
 }
 
 std::string fmt(double value) {

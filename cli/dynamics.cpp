@@ -48,7 +48,11 @@ void run_dynamics(const DynamicsOptions& opt) {
   const RobotDescription robot = load_robot_file(opt.robot, opt.package_path);
   const Model& model = robot.model;
   const int n = model.nq();
-  const Pose X_WS = given_pose ? *given_pose : default_sensor_pose(model, nullptr);
+  std::string which = "--sensor-pose";
+  const Pose X_WS = given_pose ? *given_pose : default_sensor_pose(model, &which);
+  // On stderr: stdout may be the CSV (--out -).
+  std::cerr << "extwrench dynamics: base sensor pose X_WS: " << pose_summary(X_WS) << " (" << which
+            << ")\n";
 
   std::unique_ptr<CsvReader> reader =
       opt.in == "-" ? std::make_unique<CsvReader>(std::cin, "<stdin>")

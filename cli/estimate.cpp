@@ -1,6 +1,8 @@
 // extwrench estimate: replays a robot log (real or simulated) through the contact estimator.
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 
@@ -18,12 +20,15 @@ struct EstimateOptions {
   std::filesystem::path config;
   std::filesystem::path log;
   std::filesystem::path out;
-  double metrics_from = 0.0;
+  // As `simulate` (a scenario's metrics.from default): after the residual's transient.
+  double metrics_from = 0.2;
   double metrics_to = std::numeric_limits<double>::infinity();
   std::vector<std::string> exclude;
   bool surface_metrics = false;
   bool no_figures = false;
   int plot_points = 2000;
+  std::string figure_format = "png";
+  bool ignore_extra_joints = false;
   std::vector<std::filesystem::path> package_path;
 };
 
@@ -39,7 +44,7 @@ std::pair<double, double> parse_interval(const std::string& text) {
 
 void run_estimate(const EstimateOptions& opt) {
   sim::MetricsWindow window{opt.metrics_from, opt.metrics_to, {}};
-  std::string description = "from t = " + format_number(opt.metrics_from) + " s";
+  std::string description = "t >= " + format_number(opt.metrics_from) + " s";
   for (const auto& e : opt.exclude) {
     window.exclude.push_back(parse_interval(e));
     description += ", excluding [" + e + "] s";
@@ -60,8 +65,16 @@ void run_estimate(const EstimateOptions& opt) {
   replay.windows.push_back({"window", description, window});
   replay.surface_metrics = opt.surface_metrics;
   replay.figures = !opt.no_figures;
+  replay.figure_format = *parse_figure_format(opt.figure_format);  // checked by CLI11
+  replay.ignore_extra_joint_columns = opt.ignore_extra_joints;
   replay.plot_points = opt.plot_points;
-  replay.progress = isatty(STDERR_FILENO) != 0;
+  replay.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere
+  if (config.options.sensor.type != SensorType::kNone) {
+    std::cout << "extwrench estimate: base sensor pose X_WS: "
+              << pose_summary(config.options.sensor.pose) << " (" << config.sensor_pose_source
+              << ")\n"
+              << std::flush;
+  }
   const ReplayResult r =
       replay_log(config.robot.model, config.robot.geometry, config.options, replay);
 
@@ -69,13 +82,14 @@ void run_estimate(const EstimateOptions& opt) {
             << (opt.out / "estimates.csv").string() << "\n";
   if (r.has_truth) {
     const sim::Metrics& m = r.report.windows.front().metrics;
-    std::cout << "  metrics (" << description << "): force error RMS " << fmt(m.force.rms())
-              << " N, max " << fmt(m.force.max) << " N; line of action RMS " << fmt(m.line.rms())
-              << " m; right link " << fmt(100.0 * m.isolation_accuracy()) << " %; false alarms "
-              << m.false_alarms << "\n"
-              << "  -> " << (opt.out / "metrics.json").string() << "\n";
+    std::cout << "  metrics (" << description << "), as in `extwrench simulate`:\n" << std::flush;
+    print_metrics_header();
+    print_metrics_row(replay.name, "-", m, nullptr, NAN);
+    std::fflush(stdout);
+    std::cout << "  -> " << (opt.out / "metrics.json").string() << "\n";
   }
   for (const auto& f : r.figures) std::cout << "  figure: " << f.string() << "\n";
+  for (const auto& f : r.figure_failures) std::cout << "  figure NOT drawn: " << f << "\n";
 }
 
 }  // namespace
@@ -94,7 +108,8 @@ void register_estimate(CLI::App& app) {
       ->type_name("LOG.csv");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
   sub->add_option("--metrics-from", opt->metrics_from,
-                  "Start of the metrics window [s] (default 0)")
+                  "Start of the metrics window [s] (default 0.2, after the residual's transient, "
+                  "as simulate)")
       ->type_name("T");
   sub->add_option("--metrics-to", opt->metrics_to,
                   "End of the metrics window [s] (default: end of log)")
@@ -107,6 +122,10 @@ void register_estimate(CLI::App& app) {
   sub->add_option("--plot-points", opt->plot_points,
                   "Points per figure after decimation (default 2000)")
       ->type_name("N");
+  add_figure_format_option(*sub, opt->figure_format);
+  sub->add_flag("--ignore-extra-joints", opt->ignore_extra_joints,
+                "Ignore log columns of joints beyond the robot's n (q8.. on a 7-joint robot); "
+                "without it they are an error");
   add_package_path_option(*sub, opt->package_path);
   sub->callback([opt]() { run_estimate(*opt); });
 }

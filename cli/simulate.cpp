@@ -11,6 +11,8 @@
 #include "commands.hpp"
 #include "extwrench/app/scenario_run.hpp"
 #include "extwrench/core/error.hpp"
+#include "extwrench/estimation/base_sensor.hpp"
+#include "extwrench/io/estimator_config.hpp"
 
 namespace extwrench::cli {
 namespace {
@@ -19,6 +21,7 @@ struct SimulateOptions {
   std::filesystem::path scenario;
   std::filesystem::path out;
   bool no_figures = false;
+  std::string figure_format = "png";
   std::vector<std::filesystem::path> package_path;
 };
 
@@ -36,14 +39,66 @@ std::string cell(double v, const char* format) {
   return buf;
 }
 
+// One row per seed, the worst over the seeds, and the scenario's targets for the scheme.
+void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
+                  const std::vector<SeedResult>& results) {
+  double worst_f = 0.0, worst_f_outside = 0.0, worst_line = 0.0, worst_link = 1.0;
+  for (const SeedResult& r : results) {
+    for (const SchemeResult& sr : r.schemes) {
+      if (sr.name != scheme.name) continue;
+      const NamedMetrics* a = window_named(sr.replay, "after_transient");
+      const NamedMetrics* b = window_named(sr.replay, "outside_singularity");
+      if (!a) continue;
+      const sim::Metrics& m = a->metrics;
+      print_metrics_row(scheme.name, std::to_string(r.seed), m, b ? &b->metrics : nullptr,
+                        r.peak_condition);
+      worst_f = std::max(worst_f, m.force.rms());
+      if (b) worst_f_outside = std::max(worst_f_outside, b->metrics.force.rms());
+      if (m.line.count > 0) worst_line = std::max(worst_line, m.line.rms());
+      worst_link = std::min(worst_link, m.isolation_accuracy());
+    }
+  }
+  if (results.size() > 1) {
+    std::printf("%-12s %6s %10s %9s %9s %8s m %10s %9s\n", scheme.name.c_str(), "worst",
+                cell(worst_f, "%.3f").c_str(), "", cell(worst_f_outside, "%.3f").c_str(),
+                cell(worst_line, "%.4f").c_str(), "", cell(100.0 * worst_link, "%.2f").c_str());
+  }
+  for (const MetricTarget& t : scenario.targets) {
+    if (t.scheme != scheme.name) continue;
+    const bool lower_bound = t.metric == "right_link";
+    double worst = lower_bound ? INFINITY : -INFINITY;
+    for (const SeedResult& r : results) {
+      for (const SchemeResult& sr : r.schemes) {
+        if (sr.name != scheme.name) continue;
+        const double v = target_metric(sr.replay, t.metric);
+        if (std::isfinite(v)) worst = lower_bound ? std::min(worst, v) : std::max(worst, v);
+      }
+    }
+    const bool met = std::isfinite(worst) && (lower_bound ? worst >= t.value : worst <= t.value);
+    std::printf("%-12s %6s %s %s %.4g: worst %.4g  %s\n", scheme.name.c_str(), "target",
+                t.metric.c_str(), lower_bound ? ">=" : "<=", t.value, worst,
+                met ? "met" : "NOT MET");
+  }
+}
+
 void run_simulate(const SimulateOptions& opt) {
   LoadOptions load;
   load.package_path = opt.package_path;
   const Scenario scenario = load_scenario(opt.scenario, load);
+  const Pose& X_WS = scenario.simulation.sensor.X_WS;
+  const bool default_pose =
+      X_WS.translation == default_sensor_pose(scenario.robot.model).translation &&
+      X_WS.rotation == default_sensor_pose(scenario.robot.model).rotation;
+  std::fprintf(stderr, "extwrench simulate: base sensor pose X_WS: %s (%s)\n",
+               pose_summary(X_WS).c_str(),
+               default_pose ? describe_default_sensor_pose(scenario.robot.model).c_str()
+                            : "sensors.base.pose");
   RunOptions run;
   run.figures = !opt.no_figures;
-  run.progress = isatty(STDERR_FILENO) != 0;
-  const std::vector<SeedResult> results = run_scenario(scenario, opt.out, run);
+  run.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere
+  run.figure_format = *parse_figure_format(opt.figure_format);  // checked by CLI11
+  RunSummary summary;
+  const std::vector<SeedResult> results = run_scenario(scenario, opt.out, run, &summary);
 
   std::printf(
       "\nextwrench simulate: %s, %zu seed(s), %.3g s at %.3g ms, dynamic parameters ±%g %%\n",
@@ -51,48 +106,20 @@ void run_simulate(const SimulateOptions& opt) {
       1e3 * scenario.simulation.sample_time, 100.0 * scenario.model_error);
   const std::string from = cell(scenario.metrics_from, "%g");
   std::printf(
-      "Metrics after t = %s s; 'F RMS*' excludes ±%g s around the peak of cond(J of O_l), l = "
-      "%s.\n\n",
-      from.c_str(), scenario.singularity_half_width,
+      "Metrics after t = %s s; 'F RMS*' excludes ±%g s around every crossing of cond(J of O_l) > "
+      "%g, l = %s.\n\n",
+      from.c_str(), scenario.singularity_half_width, scenario.singularity_threshold,
       scenario.singularity_link.empty() ? "-" : scenario.singularity_link.c_str());
-  std::printf("%-12s %6s %10s %9s %9s %10s %10s %9s %7s %9s %12s\n", "scheme", "seed", "F RMS [N]",
-              "F max [N]", "F RMS*[N]", "line RMS", "line max", "link [%]", "missed", "false al.",
-              "peak cond");
-  for (const SchemeSpec& scheme : scenario.schemes) {
-    double worst_f = 0.0, worst_f_outside = 0.0, worst_line = 0.0, worst_link = 1.0;
-    for (const SeedResult& r : results) {
-      for (const SchemeResult& sr : r.schemes) {
-        if (sr.name != scheme.name) continue;
-        const NamedMetrics* a = window_named(sr.replay, "after_transient");
-        const NamedMetrics* b = window_named(sr.replay, "outside_singularity");
-        if (!a) continue;
-        const sim::Metrics& m = a->metrics;
-        std::printf("%-12s %6llu %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n",
-                    scheme.name.c_str(), static_cast<unsigned long long>(r.seed),
-                    cell(m.force.rms(), "%.3f").c_str(), cell(m.force.max, "%.2f").c_str(),
-                    b ? cell(b->metrics.force.rms(), "%.3f").c_str() : "-",
-                    cell(m.line.rms(), "%.4f").c_str(),
-                    cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
-                    cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
-                    cell(r.peak_condition, "%.3g").c_str());
-        worst_f = std::max(worst_f, m.force.rms());
-        if (b) worst_f_outside = std::max(worst_f_outside, b->metrics.force.rms());
-        if (m.line.count > 0) worst_line = std::max(worst_line, m.line.rms());
-        worst_link = std::min(worst_link, m.isolation_accuracy());
-      }
-    }
-    if (results.size() > 1) {
-      std::printf("%-12s %6s %10s %9s %9s %8s m %10s %9s\n", scheme.name.c_str(), "worst",
-                  cell(worst_f, "%.3f").c_str(), "", cell(worst_f_outside, "%.3f").c_str(),
-                  cell(worst_line, "%.4f").c_str(), "", cell(100.0 * worst_link, "%.2f").c_str());
-    }
-  }
+  print_metrics_header();
+  for (const SchemeSpec& scheme : scenario.schemes) print_scheme(scenario, scheme, results);
   std::printf(
       "\nOutputs (per seed: log.csv, model_estimator.urdf; per scheme: config.yaml, estimates.csv, "
       "metrics.json, figures):\n");
   for (const SeedResult& r : results) {
     std::printf("  %s\n", r.dir.string().c_str());
   }
+  if (!summary.figure.empty())
+    std::printf("Summary across seeds: %s\n", summary.figure.string().c_str());
   if (!results.empty() && !results.front().schemes.empty() &&
       !results.front().schemes.front().replay.figures.empty()) {
     std::printf("Figures, e.g.:\n");
@@ -115,6 +142,7 @@ void register_simulate(CLI::App& app) {
       ->type_name("SCENARIO.yaml");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
   sub->add_flag("--no-figures", opt->no_figures, "Do not draw figures (no gnuplot needed)");
+  add_figure_format_option(*sub, opt->figure_format);
   add_package_path_option(*sub, opt->package_path);
   sub->callback([opt]() { run_simulate(*opt); });
 }

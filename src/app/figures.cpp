@@ -12,35 +12,11 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "figure_script.hpp"
+#include "robot3d.hpp"
 
 namespace extwrench::detail {
-namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// Columns of the decimated plot buffer.
-enum Col : int {
-  kT = 0,
-  kContact,
-  kF = 2,
-  kFt = 5,
-  kL = 8,
-  kDir = 11,
-  kP = 14,
-  kPt = 17,
-  kCond = 20,
-  kCondTrue,
-  kTrueContact,
-  kErrF,
-  kQ  // q1..qn follow
-};
-
-constexpr const char* kAxis[] = {"x", "y", "z"};
-
-// gnuplot's 1-based column of a buffer column.
-std::string col(int c) { return std::to_string(c + 1); }
-
-// Text for gnuplot's enhanced mode: '_' and '^' would start sub- and superscripts.
 std::string enhanced(const std::string& text) {
   std::string out;
   for (const char c : text) {
@@ -51,262 +27,237 @@ std::string enhanced(const std::string& text) {
   return out;
 }
 
-void write_script(const std::filesystem::path& path, const std::string& text) {
-  std::ofstream out(path);
-  if (!out) throw Error(path.string() + ": cannot create the file");
-  out << text;
-}
-
-// What every figure's script needs.
-struct PlotContext {
-  std::filesystem::path dir;
-  std::string data;   // plot_data.txt, as a gnuplot string
-  std::string title;  // the run's name
-  int n = 0;          // joints
-  bool truth = false;
-};
-
-struct Figure {
-  std::filesystem::path script;
-  std::filesystem::path png;
-};
-
-Figure figure(const PlotContext& c, const std::string& name) {
-  return {c.dir / (name + ".gp"), c.dir / (name + ".png")};
-}
-
-// Fig. 5: joint positions.
-Figure plot_joints(const PlotContext& c) {
-  const Figure f = figure(c, "joints");
-  std::ostringstream s;
-  s << gnuplot_png_preamble(f.png) << "set title "
-    << gnuplot_quote("Joint positions — " + enhanced(c.title))
-    << "\nset xlabel 't [s]'\nset ylabel 'q_i [rad]'\nplot ";
-  for (int i = 0; i < c.n; ++i) {
-    s << (i ? ", " : "") << c.data << " using 1:" << col(kQ + i) << " with lines lw 2 title 'q_"
-      << i + 1 << "'";
+void plot_series(std::ostream& s, const PlotContext& c, const std::vector<Series>& series,
+                 const std::string& why, bool log_scale, const std::string& extra) {
+  std::string list;
+  for (const Series& x : series) {
+    const auto k = static_cast<std::size_t>(x.column);
+    if (!(log_scale ? c.positive[k] : c.present[k])) continue;
+    list += (list.empty() ? "" : ", ") + c.data + " using 1:" + col(x.column) + " " + x.style +
+            " title " + gnuplot_quote(x.title);
   }
-  s << "\n";
-  write_script(f.script, s.str());
-  return f;
+  if (list.empty()) {
+    // An empty frame over the log's span: gnuplot refuses to autoscale on no data.
+    const double t1 = c.t_end > c.t_begin ? c.t_end : c.t_begin + 1.0;
+    s << "unset logscale y\nset xrange [" << c.t_begin << ":" << t1 << "]\nset yrange [0:1]\n"
+      << "set label 1 " << gnuplot_quote(enhanced(why)) << " at graph 0.5, 0.5 center\n"
+      << "plot 2 notitle\nunset label 1\nset autoscale x\nset autoscale y\n";
+    return;
+  }
+  if (log_scale) s << "set logscale y\n";
+  s << "plot " << list << extra << "\n";
+  if (log_scale) s << "unset logscale y\n";
+}
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Keys sit outside the plot area, on the right, so that they never hide a curve or a title.
+constexpr const char* kKey = "set key outside right top vertical samplen 2\n";
+
+void write_script(const std::filesystem::path& path, const std::string& text,
+                  OutputFiles& outputs) {
+  const std::filesystem::path partial = outputs.stage(path);
+  {
+    std::ofstream out(partial);
+    if (!out) throw Error(partial.string() + ": cannot create the file");
+    out << text;
+    out.flush();
+    if (!out) throw Error(partial.string() + ": write failed (disk full?)");
+  }
+  outputs.commit(path);
+}
+
+// Fig. 5: joint positions, and the desired ones when the controller's trajectory is known.
+std::string joints_script(const PlotContext& c, const Figure& f) {
+  std::ostringstream s;
+  s << gnuplot_preamble(f.output, c.format, 1100, 700) << kKey << "set title "
+    << gnuplot_quote("Joint positions — " + enhanced(c.title))
+    << "\nset xlabel 't [s]'\nset ylabel 'q_i [rad]'\n";
+  std::vector<Series> series;
+  for (int i = 0; i < c.n; ++i) {
+    const std::string lt = " lt " + std::to_string(i + 1);
+    series.push_back({kQ + i, "with lines lw 2" + lt, "q_" + std::to_string(i + 1)});
+    series.push_back(
+        {kQ + c.n + i, "with lines lw 1 dt 2" + lt, "q_{d," + std::to_string(i + 1) + "}"});
+  }
+  plot_series(s, c, series, "no joint positions in the log");
+  return s.str();
 }
 
 // Figs. 6 / 8: estimated and true force, and the error norm (the contact flag without truth).
-Figure plot_force(const PlotContext& c) {
-  const Figure f = figure(c, "force");
+std::string force_script(const PlotContext& c, const Figure& f) {
   std::ostringstream s;
-  s << gnuplot_png_preamble(f.png, 1000, 1000) << "set multiplot layout 4,1 title "
+  s << gnuplot_preamble(f.output, c.format, 1100, 1000) << kKey << "set multiplot layout 4,1 title "
     << gnuplot_quote("External force, world frame — " + enhanced(c.title)) << "\n"
-    << "set key inside right top horizontal\nset lmargin 10\n";
+    << "set lmargin 10\nset rmargin 22\n";
   for (int k = 0; k < 3; ++k) {
-    s << "set ylabel 'F_" << kAxis[k] << " [N]'\nunset xlabel\nplot " << c.data
-      << " using 1:" << col(kF + k) << " with lines lw 2 lc rgb '#1f77b4' title 'estimated'";
-    if (c.truth)
-      s << ", " << c.data << " using 1:" << col(kFt + k)
-        << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true'";
-    s << "\n";
+    s << "set ylabel 'F_" << kAxis[k] << " [N]'\nunset xlabel\n";
+    plot_series(s, c,
+                {{kF + k, "with lines lw 2 lc rgb '#1f77b4'", "estimated"},
+                 {kFt + k, "with lines lw 2 dt 2 lc rgb '#d62728'", "true"}},
+                "no force estimated (no contact detected)");
   }
+  s << "set xlabel 't [s]'\n";
   if (c.truth) {
-    s << "set ylabel '|F_{est} - F| [N]'\nset xlabel 't [s]'\nset logscale y\nplot " << c.data
-      << " using 1:" << col(kErrF)
-      << " with lines lw 2 lc rgb '#2ca02c' title 'force error'\nunset logscale y\n";
+    s << "set ylabel '|F_{est} - F| [N]'\n";
+    plot_series(s, c, {{kErrF, "with lines lw 2 lc rgb '#2ca02c'", "force error"}},
+                "no force error above zero", true);
   } else {
-    s << "set ylabel 'contact'\nset xlabel 't [s]'\nset yrange [-0.1:1.1]\nplot " << c.data
-      << " using 1:" << col(kContact) << " with steps lw 2 title 'contact detected'\n";
-  }
-  s << "unset multiplot\n";
-  write_script(f.script, s.str());
-  return f;
-}
-
-// Figs. 7 / 9: p̂ of eq. (20) and the true contact point.
-Figure plot_line_point(const PlotContext& c) {
-  const Figure f = figure(c, "line_point");
-  std::ostringstream s;
-  s << gnuplot_png_preamble(f.png, 1000, 850) << "set multiplot layout 3,1 title "
-    << gnuplot_quote("Point of the line of action p̂ (eq. 20), world frame — " + enhanced(c.title))
-    << "\n"
-    << "set key inside right top horizontal\nset lmargin 10\n";
-  for (int k = 0; k < 3; ++k) {
-    s << "set ylabel 'p_" << kAxis[k] << " [m]'\n"
-      << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n") << "plot " << c.data
-      << " using 1:" << col(kL + k) << " with lines lw 2 lc rgb '#1f77b4' title 'estimated p̂'";
-    if (c.truth)
-      s << ", " << c.data << " using 1:" << col(kPt + k)
-        << " with lines lw 2 dt 2 lc rgb '#d62728' title 'true point'";
-    s << "\n";
-  }
-  s << "unset multiplot\n";
-  write_script(f.script, s.str());
-  return f;
-}
-
-// Fig. 10: condition numbers.
-Figure plot_condition(const PlotContext& c) {
-  const Figure f = figure(c, "condition");
-  std::ostringstream s;
-  s << gnuplot_png_preamble(f.png, 1000, 600) << "set title "
-    << gnuplot_quote("Condition number — " + enhanced(c.title))
-    << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\nset logscale y\nset key inside "
-       "left top\nplot "
-    << c.data << " using 1:" << col(kCond)
-    << " with lines lw 2 lc rgb '#1f77b4' title 'Jacobian inverted by the estimator'";
-  if (c.truth) {
-    s << ", " << c.data << " using 1:" << col(kCondTrue)
-      << " with lines lw 2 dt 2 lc rgb '#d62728' title 'J of O_l (world frame, SI), l = true "
-         "contact link'";
-  }
-  s << "\n";
-  write_script(f.script, s.str());
-  return f;
-}
-
-// The rows of the 3-D view: `count` instants at the middles of equal slices of the kept rows.
-std::vector<int> snapshot_rows(int available, int snapshots) {
-  std::vector<int> rows;
-  const int count = std::max(1, std::min(snapshots, available));
-  for (int k = 0; k < count && available > 0; ++k) {
-    rows.push_back(
-        static_cast<int>((static_cast<long long>(available - 1) * (2 * k + 1)) / (2 * count)));
-  }
-  return rows;
-}
-
-// One point, or "NaN NaN NaN" (gnuplot draws nothing) when absent; then the block's end.
-void point_block(std::ostream& out, bool present, const double* p) {
-  if (present) {
-    out << p[0] << " " << p[1] << " " << p[2] << "\n";
-  } else {
-    out << "NaN NaN NaN\n";
-  }
-  out << "\n\n";
-}
-
-// One snapshot's four blocks (gnuplot index 4k .. 4k+3): the skeleton (sensor, then body
-// origins), the true point, the line of action (± 0.3 m about p̂), the surface point. Returns
-// the half-width of a cube that holds the skeleton, at least `extent`.
-double write_snapshot(std::ostream& out, const Model& model, Data& data, const double* row,
-                      bool truth, const Vector3& p_WS, double extent) {
-  const int n = model.nq();
-  VectorX q(n);
-  for (int i = 0; i < n; ++i) q[i] = row[kQ + i];
-  forward_kinematics(model, data, q);
-  out << p_WS.x() << " " << p_WS.y() << " " << p_WS.z() << "\n";  // the base sensor
-  for (int b = 0; b < model.num_bodies(); ++b) {
-    const Vector3& p = data.X_WB[b].translation;
-    out << p.x() << " " << p.y() << " " << p.z() << "\n";
-    extent = std::max(extent, p.cwiseAbs().maxCoeff());
-  }
-  out << "\n\n";
-  point_block(out, truth && row[kTrueContact] > 0.5, row + kPt);
-  if (std::isfinite(row[kL]) && std::isfinite(row[kDir])) {
-    for (const double lambda : {-0.3, 0.3}) {
-      out << row[kL] + lambda * row[kDir] << " " << row[kL + 1] + lambda * row[kDir + 1] << " "
-          << row[kL + 2] + lambda * row[kDir + 2] << "\n";
-    }
-    out << "\n\n";
-  } else {
-    point_block(out, false, nullptr);
-  }
-  point_block(out, std::isfinite(row[kP]), row + kP);
-  return extent;
-}
-
-// The 3-D view's script: one splot per snapshot, in a grid of two columns.
-std::string robot3d_script(const PlotContext& c, const Figure& f, const Decimator& rows,
-                           const std::vector<int>& shots, double extent, const Vector3& p_WS) {
-  std::ostringstream s;
-  const int cols = shots.size() > 1 ? 2 : 1;
-  const int lines = static_cast<int>((shots.size() + 1) / 2);
-  s << gnuplot_png_preamble(f.png, 1100, 550 * std::max(1, lines)) << "set multiplot layout "
-    << std::max(1, lines) << "," << cols << " title "
-    << gnuplot_quote("Robot, true contact point and estimated line of action — " +
-                     enhanced(c.title))
-    << "\n"
-    << "set view 62,30,1.2\nset view equal xyz\n"
-    << "set xrange [" << -extent << ":" << extent << "]\nset yrange [" << -extent << ":" << extent
-    << "]\nset zrange [" << std::min(-0.35, p_WS.z() - 0.05) << ":" << extent + 0.1 << "]\n"
-    << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]'\nset key at screen 0.99, "
-       "screen 0.995 top right samplen 2\n"
-    << "set ticslevel 0\n";
-  for (std::size_t k = 0; k < shots.size(); ++k) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "t = %.2f s", rows.row(shots[k])[kT]);
-    s << "set title '" << buf << "'\n"
-      << "splot 'robot3d.txt' index " << 4 * k
-      << " with linespoints lw 4 pt 7 ps 1 lc rgb '#555555' title "
-      << (k == 0 ? "'links (sensor, joint frame origins)'" : "''") << ", "
-      << "'' index " << 4 * k + 1 << " with points pt 7 ps 2 lc rgb '#d62728' title "
-      << (k == 0 ? "'true point'" : "''") << ", "
-      << "'' index " << 4 * k + 2 << " with lines lw 3 lc rgb '#1f77b4' title "
-      << (k == 0 ? "'estimated line of action'" : "''") << ", "
-      << "'' index " << 4 * k + 3 << " with points pt 9 ps 2 lc rgb '#2ca02c' title "
-      << (k == 0 ? "'estimated surface point'" : "''") << "\n";
+    s << "set ylabel 'contact'\nset yrange [-0.1:1.1]\n";
+    plot_series(s, c, {{kContact, "with steps lw 2", "contact detected"}}, "no rows");
   }
   s << "unset multiplot\n";
   return s.str();
 }
 
-// The 3-D view at a few instants: robot3d.txt and its script.
-Figure plot_robot3d(const PlotContext& c, const Model& model, const Decimator& rows, int snapshots,
-                    const Vector3& p_WS) {
-  const Figure f = figure(c, "robot3d");
-  const std::vector<int> shots = snapshot_rows(rows.rows(), snapshots);
-  Data data(model);
-  std::ofstream out(c.dir / "robot3d.txt");
-  double extent = 0.3;
-  for (const int r : shots)
-    extent = write_snapshot(out, model, data, rows.row(r), c.truth, p_WS, extent);
-  out.close();
-  write_script(f.script, robot3d_script(c, f, rows, shots, extent, p_WS));
-  return f;
+// Figs. 7 / 9: p̂ of eq. (20) and the true contact point.
+std::string line_point_script(const PlotContext& c, const Figure& f) {
+  std::ostringstream s;
+  s << gnuplot_preamble(f.output, c.format, 1100, 850) << kKey << "set multiplot layout 3,1 title "
+    << gnuplot_quote("Point of the line of action p̂ (eq. 20), world frame — " + enhanced(c.title))
+    << "\nset lmargin 10\nset rmargin 22\n";
+  for (int k = 0; k < 3; ++k) {
+    s << "set ylabel 'p_" << kAxis[k] << " [m]'\n"
+      << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n");
+    plot_series(s, c,
+                {{kL + k, "with lines lw 2 lc rgb '#1f77b4'", "estimated p̂"},
+                 {kPt + k, "with lines lw 2 dt 2 lc rgb '#d62728'", "true point"}},
+                "no line of action estimated");
+  }
+  s << "unset multiplot\n";
+  return s.str();
 }
 
-// gnuplot draws on one core and the figures are independent: two at a time. A failure is
-// reported for the first failing script in order, as a sequential run would report it.
-void run_gnuplot_scripts(const std::vector<Figure>& figures) {
-  std::vector<std::exception_ptr> errors(figures.size());
+// The time spans where the estimate was flagged ill_conditioned (the solver damped), as shaded
+// rectangles behind the curves; spans closer than 1/kMaxSpans of the log are merged, so that a
+// flag that flickers draws a few rectangles, not thousands.
+std::string flagged_spans(const EnvelopeDecimator& rows, double t_begin, double t_end) {
+  constexpr int kMaxSpans = 200;
+  const double gap = (t_end - t_begin) / kMaxSpans;
+  std::vector<std::pair<double, double>> spans;
+  for (int i = 0; i < rows.rows(); ++i) {
+    const double* r = rows.row(i);
+    if (!(r[kIll] > 0.5)) continue;
+    if (!spans.empty() && r[kT] - spans.back().second <= gap) {
+      spans.back().second = r[kT];
+    } else {
+      spans.emplace_back(r[kT], r[kT]);
+    }
+  }
+  std::ostringstream s;
+  int id = 10;
+  for (const auto& [a, b] : spans) {
+    s << "set object " << id++ << " rect from " << a << ", graph 0 to "
+      << std::max(b, a + gap * 0.2) << ", graph 1 behind fc rgb '#fdd0c8' fs solid 1.0 noborder\n";
+  }
+  return s.str();
+}
+
+// Fig. 10: condition numbers, the solver's damping threshold and the damped spans.
+std::string condition_script(const PlotContext& c, const Figure& f, const EnvelopeDecimator& rows,
+                             double max_condition) {
+  std::ostringstream s;
+  s << gnuplot_preamble(f.output, c.format, 1100, 600) << kKey << "set title "
+    << gnuplot_quote("Condition number — " + enhanced(c.title))
+    << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\n";
+  const std::string spans = flagged_spans(rows, c.t_begin, c.t_end);
+  s << spans;
+  std::string extra;
+  if (max_condition > 0.0) {
+    extra = ", " + std::to_string(max_condition) +
+            " with lines lw 1.5 dt 3 lc rgb 'black' title 'damping threshold'";
+  }
+  if (!spans.empty())
+    extra +=
+        ", keyentry with boxes fc rgb '#fdd0c8' fs solid 1.0 noborder title 'damped (flagged)'";
+  plot_series(
+      s, c,
+      {{kCond, "with lines lw 2 lc rgb '#1f77b4'", "J inverted by the estimator"},
+       {kCondTrue, "with lines lw 2 dt 2 lc rgb '#d62728'", "J of O_l, l = true link"},
+       {kCondEstimated, "with lines lw 2 dt 2 lc rgb '#2ca02c'", "J of O_l, l = estimated link"}},
+      "no Jacobian (no contact detected)", true, extra);
+  return s.str();
+}
+
+// The per-column facts the scripts need: which columns have data, and the time span.
+PlotContext context_of(const FigureOptions& o, const EnvelopeDecimator& rows, int n, bool truth) {
+  PlotContext c;
+  c.dir = o.dir;
+  c.data = gnuplot_quote("plot_data.txt");
+  c.title = o.title;
+  c.n = n;
+  c.truth = truth;
+  c.format = o.format;
+  c.present.assign(static_cast<std::size_t>(rows.width()), 0);
+  c.positive.assign(static_cast<std::size_t>(rows.width()), 0);
+  for (int i = 0; i < rows.rows(); ++i) {
+    const double* r = rows.row(i);
+    for (int k = 0; k < rows.width(); ++k) {
+      if (std::isfinite(r[k])) c.present[static_cast<std::size_t>(k)] = 1;
+      if (std::isfinite(r[k]) && r[k] > 0.0) c.positive[static_cast<std::size_t>(k)] = 1;
+    }
+  }
+  if (rows.rows() > 0) {
+    c.t_begin = rows.row(0)[kT];
+    c.t_end = rows.row(rows.rows() - 1)[kT];
+  }
+  return c;
+}
+
+// gnuplot draws on one core and the figures are independent: two at a time. Each draws to
+// its ".partial" name; the error of a failed one is kept for the caller.
+std::vector<std::string> run_scripts(const std::vector<Figure>& figures) {
+  std::vector<std::string> errors(figures.size());
   std::atomic<std::size_t> next{0};
   auto run_some = [&] {
     for (std::size_t k = next++; k < figures.size(); k = next++) {
       try {
-        run_gnuplot(figures[k].script);
-      } catch (...) {
-        errors[k] = std::current_exception();
+        run_gnuplot(figures[k].script, OutputFiles::partial_name(figures[k].output));
+      } catch (const std::exception& e) {
+        errors[k] = e.what();
+        if (errors[k].empty()) errors[k] = "gnuplot failed";
       }
     }
   };
   std::thread helper(run_some);
   run_some();
   helper.join();
-  for (const auto& error : errors) {
-    if (error) std::rethrow_exception(error);
-  }
+  return errors;
 }
 
 }  // namespace
 
-FigureRecorder::FigureRecorder(const Model& model, bool truth, int max_points)
+FigureRecorder::FigureRecorder(const Model& model, bool truth, int max_points,
+                               const sim::SinusoidalTrajectory* desired)
     : model_(model),
       truth_(truth),
-      rows_(kQ + model.nq(), max_points),
-      row_(static_cast<std::size_t>(kQ + model.nq())),
-      data_(model) {}
+      desired_(desired != nullptr && desired->size() == model.nq() ? desired : nullptr),
+      rows_(kQ + 2 * model.nq(), max_points),
+      snapshot_rows_(kQ + 2 * model.nq(), 64),
+      row_(static_cast<std::size_t>(kQ + 2 * model.nq())),
+      data_(model),
+      q_d_(model.nq()),
+      dq_d_(model.nq()),
+      ddq_d_(model.nq()) {}
 
 void FigureRecorder::add(const Sample& sample, const ContactEstimate& estimate) {
-  if (!rows_.wants_next()) {
-    rows_.skip();
-    return;
-  }
   double* r = row_.data();
+  const int n = model_.nq();
   r[kT] = sample.t;
-  estimate_columns(estimate, r);
+  estimate_columns(sample, estimate, r);
   truth_columns(sample, estimate, r);
-  for (int i = 0; i < model_.nq(); ++i) r[kQ + i] = sample.q[i];
+  if (desired_ != nullptr) desired_->evaluate(sample.t, q_d_, dq_d_, ddq_d_);
+  for (int i = 0; i < n; ++i) {
+    r[kQ + i] = sample.q[i];
+    r[kQ + n + i] = desired_ != nullptr ? q_d_[i] : kNaN;
+  }
   rows_.push(r);
+  snapshot_rows_.push(r);
 }
 
-void FigureRecorder::estimate_columns(const ContactEstimate& e, double* r) const {
+void FigureRecorder::estimate_columns(const Sample& s, const ContactEstimate& e, double* r) {
   r[kContact] = e.contact ? 1.0 : 0.0;
   for (int k = 0; k < 3; ++k) {
     r[kF + k] = e.contact ? e.force_W[k] : kNaN;
@@ -315,6 +266,13 @@ void FigureRecorder::estimate_columns(const ContactEstimate& e, double* r) const
     r[kP + k] = e.contact ? e.point_W[k] : kNaN;
   }
   r[kCond] = e.condition_number;
+  r[kIll] = e.has(EstimateFlag::kIllConditioned) ? 1.0 : 0.0;
+  r[kCondEstimated] = kNaN;
+  // On a log without truth, the contact link's conditioning is still worth seeing.
+  if (!truth_ && e.contact && e.link > 0 && s.q.size() == model_.nq()) {
+    forward_kinematics(model_, data_, s.q);
+    r[kCondEstimated] = jacobian_condition(model_, data_, e.link);
+  }
 }
 
 void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, double* r) {
@@ -325,6 +283,7 @@ void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, do
   }
   r[kTrueContact] = touched ? 1.0 : 0.0;
   r[kCondTrue] = kNaN;
+  // Every row (not only kept ones): the envelope keeps the singular peak (Fig. 10).
   if (truth_ && s.truth.body > 0) {
     forward_kinematics(model_, data_, s.q);
     r[kCondTrue] = jacobian_condition(model_, data_, s.truth.body);
@@ -337,18 +296,37 @@ void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, do
   }
 }
 
-std::vector<std::filesystem::path> FigureRecorder::draw(const FigureOptions& o) const {
+DrawnFigures FigureRecorder::draw(const FigureOptions& o, OutputFiles& parent) const {
+  // A transaction of their own: a failure half-way (disk full) removes every figure file and
+  // leaves the command's other outputs alone; on success the parent owns the files.
+  OutputFiles outputs;
   const std::filesystem::path data = o.dir / "plot_data.txt";
-  rows_.write(data);
-  const PlotContext c{o.dir, gnuplot_quote(data.filename().string()), o.title, model_.nq(), truth_};
-  // In braces: evaluated in order, so the files are written in the order of the list.
-  const std::vector<Figure> figures{plot_joints(c), plot_force(c), plot_line_point(c),
-                                    plot_condition(c),
-                                    plot_robot3d(c, model_, rows_, o.snapshots, o.p_WS)};
-  run_gnuplot_scripts(figures);
-  std::vector<std::filesystem::path> pngs;
-  for (const Figure& f : figures) pngs.push_back(f.png);
-  return pngs;
+  rows_.write(outputs.stage(data));
+  outputs.commit(data);
+  const PlotContext c = context_of(o, rows_, model_.nq(), truth_);
+  std::vector<Figure> figures{figure(c, "joints"), figure(c, "force"), figure(c, "line_point"),
+                              figure(c, "condition")};
+  write_script(figures[0].script, joints_script(c, figures[0]), outputs);
+  write_script(figures[1].script, force_script(c, figures[1]), outputs);
+  write_script(figures[2].script, line_point_script(c, figures[2]), outputs);
+  write_script(figures[3].script, condition_script(c, figures[3], rows_, o.max_condition), outputs);
+  const Robot3dInput in{model_, o.geometry, snapshot_rows_, o.snapshots, o.p_WS, truth_};
+  figures.push_back(plot_robot3d(c, in, outputs));
+  for (const Figure& f : figures) (void)outputs.stage(f.output);  // gnuplot draws to .partial
+  DrawnFigures drawn;
+  const std::vector<std::string> errors = run_scripts(figures);
+  for (std::size_t k = 0; k < figures.size(); ++k) {
+    if (errors[k].empty()) {
+      outputs.commit(figures[k].output);
+      drawn.files.push_back(figures[k].output);
+    } else {
+      outputs.discard(figures[k].output);
+      drawn.failures.push_back(figures[k].name + ": " + errors[k]);
+    }
+  }
+  for (const auto& file : outputs.committed()) parent.adopt(file);
+  outputs.keep();
+  return drawn;
 }
 
 }  // namespace extwrench::detail

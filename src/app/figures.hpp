@@ -1,6 +1,8 @@
-// The replay's figures (PNG through gnuplot; docs/simulation.md lists them): rows are recorded
-// while the log streams by, decimated so that memory does not grow with the log, and the data
-// and scripts are written and drawn at the end. Private to the app library.
+// The replay's figures (gnuplot; docs/simulation.md lists them): rows are recorded while the
+// log streams by, decimated so that memory does not grow with the log (min/max envelope: peaks
+// survive), and the data and scripts are written and drawn at the end. Each figure is drawn
+// to a temporary name and renamed when gnuplot succeeded; a figure that fails is reported, not
+// fatal. Private to the app library.
 #pragma once
 
 #include <filesystem>
@@ -11,39 +13,56 @@
 #include "extwrench/core/sample.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
+#include "extwrench/geometry/shapes.hpp"
+#include "extwrench/io/output_files.hpp"
+#include "extwrench/sim/trajectory.hpp"
 
 namespace extwrench::detail {
 
 /// Where and how the figures are drawn.
 struct FigureOptions {
-  std::filesystem::path dir;       ///< plot_data.txt, robot3d.txt, the scripts and PNGs
+  std::filesystem::path dir;       ///< plot_data.txt, robot3d.txt, the scripts and figures
   std::string title;               ///< the run's name, in every title
   int snapshots = 4;               ///< instants of the 3-D view
   Vector3 p_WS = Vector3::Zero();  ///< the base sensor's origin, drawn below link 0
+  double max_condition = 0.0;      ///< the solver's damping threshold (0: not drawn)
+  FigureFormat format = FigureFormat::kPng;
+  const GeometryModel* geometry = nullptr;  ///< collision shapes of the 3-D view (may be null)
+};
+
+/// The figures drawn, and one message per figure that could not be drawn.
+struct DrawnFigures {
+  std::vector<std::filesystem::path> files;
+  std::vector<std::string> failures;
 };
 
 class FigureRecorder {
  public:
   /// truth: the log has truth columns (true force and point, the force error, cond(J) of the
-  /// true contact link). At most about 2·max_points rows are kept.
-  FigureRecorder(const Model& model, bool truth, int max_points);
+  /// true contact link). desired: the trajectory the controller tracked (q_d in the joint
+  /// plot), or null. About 2·max_points rows are kept.
+  FigureRecorder(const Model& model, bool truth, int max_points,
+                 const sim::SinusoidalTrajectory* desired = nullptr);
 
-  /// One replayed sample and the estimate at it. Only kept rows are computed.
+  /// One replayed sample and the estimate at it.
   void add(const Sample& sample, const ContactEstimate& estimate);
 
-  /// Writes the data and the five scripts, runs gnuplot on them; the PNGs in the order joints,
-  /// force, line_point, condition, robot3d.
-  [[nodiscard]] std::vector<std::filesystem::path> draw(const FigureOptions& options) const;
+  /// Writes the data and the scripts and runs gnuplot on them, every file through `outputs`;
+  /// the figures in the order joints, force, line_point, condition, robot3d.
+  [[nodiscard]] DrawnFigures draw(const FigureOptions& options, OutputFiles& outputs) const;
 
  private:
-  void estimate_columns(const ContactEstimate& e, double* row) const;
+  void estimate_columns(const Sample& s, const ContactEstimate& e, double* row);
   void truth_columns(const Sample& s, const ContactEstimate& e, double* row);
 
   const Model& model_;
   bool truth_;
-  Decimator rows_;
+  const sim::SinusoidalTrajectory* desired_;
+  EnvelopeDecimator rows_;   // the time plots
+  Decimator snapshot_rows_;  // whole rows (real configurations) for the 3-D view
   std::vector<double> row_;  // the row being filled
-  Data data_;                // kinematics for cond(J) of the true contact link
+  Data data_;                // kinematics for cond(J) of the contact links
+  VectorX q_d_, dq_d_, ddq_d_;
 };
 
 }  // namespace extwrench::detail

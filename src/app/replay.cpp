@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -31,6 +32,36 @@ void note_ignored_columns(const LogReader& reader) {
   if (ignored.size() > kShown) list += " and " + std::to_string(ignored.size() - kShown) + " more";
   std::cerr << "extwrench: note: " << reader.name()
             << ": ignoring columns not in the log format: " << list << "\n";
+}
+
+// "q8", "dq8", "tau8", "true_tau_ext8" with 8 > n: a log of another robot, or of this one with
+// a gripper joint; either way the user should say so.
+bool beyond_joints(const std::string& column, int n) {
+  for (const char* prefix : {"true_tau_ext", "tau", "dq", "q"}) {
+    const std::string p = prefix;
+    if (column.size() <= p.size() || column.compare(0, p.size(), p) != 0) continue;
+    const std::string digits = column.substr(p.size());
+    if (digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos)
+      return false;
+    return std::stoi(digits) > n;
+  }
+  return false;
+}
+
+void check_joint_columns(const LogReader& reader, int n, bool ignore) {
+  if (ignore) return;
+  std::string list;
+  int count = 0;
+  for (const std::string& c : reader.ignored_columns()) {
+    if (!beyond_joints(c, n)) continue;
+    if (++count <= 8) list += (list.empty() ? "" : ", ") + c;
+  }
+  if (count == 0) return;
+  if (count > 8) list += " and " + std::to_string(count - 8) + " more";
+  throw Error(reader.name() + ":1: columns " + list + " are beyond the robot's " +
+              std::to_string(n) +
+              " joints: is this the log of another robot (or of extra joints such as a "
+              "gripper's)? Pass --ignore-extra-joints to ignore them on purpose");
 }
 
 void check_sensor_columns(const LogReader& reader, SensorType sensor) {
@@ -124,12 +155,52 @@ MetricsReport report_of(const ReplayOptions& o, const LogSpan& span) {
   return report;
 }
 
+// The figures, whose failure is a warning: the estimates and metrics are written and stand.
+void draw_figures(const detail::FigureRecorder& figures, const Model& model,
+                  const GeometryModel& geometry, const EstimatorOptions& e, const ReplayOptions& o,
+                  OutputFiles& outputs, ReplayResult& result) {
+  (void)model;
+  detail::FigureOptions fo;
+  fo.dir = o.out_dir;
+  fo.title = title_of(o);
+  fo.snapshots = o.snapshots;
+  fo.p_WS = e.sensor.pose.translation;
+  fo.max_condition = e.solver.max_condition;
+  fo.format = o.figure_format;
+  fo.geometry = &geometry;
+  try {
+    detail::DrawnFigures drawn = figures.draw(fo, outputs);
+    result.figures = std::move(drawn.files);
+    result.figure_failures = std::move(drawn.failures);
+  } catch (const std::exception& x) {
+    result.figure_failures.push_back(std::string("figures: ") + x.what());
+  }
+  for (const std::string& failure : result.figure_failures) {
+    std::cerr << "extwrench: warning: " << fo.title
+              << ": figure not drawn (the estimates stand): " << failure << "\n";
+  }
+}
+
 }  // namespace
+
+std::string disagreement_warning(const ReplayResult& r) {
+  // A few flagged samples happen at contact edges; a majority over a real contact does not.
+  constexpr long kMinContactSamples = 20;
+  if (r.contact_samples < kMinContactSamples || 2 * r.disagreement_samples <= r.contact_samples)
+    return {};
+  char pct[32];
+  std::snprintf(pct, sizeof pct, "%.0f %%", 100.0 * r.disagreement_fraction());
+  return std::string(pct) + " of the " + std::to_string(r.contact_samples) +
+         " contact samples carry 'disagreement' (the base sensor and the joint residual do not "
+         "agree): check the sensor pose (sensor.pose, or the model's 'sensor' frame), the robot "
+         "model (masses, inertias, joint order) and the sensor's calibration (bias: sensor.tare)";
+}
 
 ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator_options, const ReplayOptions& o) {
   LogReader reader(o.log, model);
   const LogLayout layout = reader.layout();  // a copy: the reader moves to its thread
+  check_joint_columns(reader, model.nq(), o.ignore_extra_joint_columns);
   if (o.warn_ignored_columns) note_ignored_columns(reader);
   check_sensor_columns(reader, estimator_options.sensor.type);
   OutputFiles own_outputs;
@@ -140,10 +211,11 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   EstimatesWriter writer(outputs.stage(estimates), model);
   WindowMetrics metrics(o.windows);
   std::optional<detail::FigureRecorder> figures;
-  if (o.figures) figures.emplace(model, layout.truth, o.plot_points);
+  if (o.figures) figures.emplace(model, layout.truth, o.plot_points, o.desired_trajectory);
   const std::string title = title_of(o);
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
   LogSpan span;
+  long contact_samples = 0, disagreement_samples = 0;
   const std::string log_name = reader.name();  // the reader belongs to its thread from here on
   detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype());
   while (const Sample* sample = pipeline.next()) {
@@ -151,6 +223,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     const ContactEstimate& e = estimator.update(s);
     pipeline.push(e);
     span.add(s.t);
+    contact_samples += e.contact ? 1 : 0;
+    disagreement_samples += e.contact && e.has(EstimateFlag::kDisagreement) ? 1 : 0;
     if (layout.truth) metrics.add(s, e);
     if (figures) figures->add(s, e);
     progress.update(span.rows, "%s: replayed %ld rows (t = %.1f s)", title.c_str(), span.rows, s.t);
@@ -165,20 +239,18 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   result.rows = span.rows;
   result.has_truth = layout.truth;
   result.report = report_of(o, span);
+  result.contact_samples = contact_samples;
+  result.disagreement_samples = disagreement_samples;
   if (layout.truth) {
     result.report.windows = metrics.result();
     const std::filesystem::path json = o.out_dir / "metrics.json";
     write_metrics_json(outputs.stage(json), result.report);
     outputs.commit(json);
   }
-  if (o.figures) {
-    result.figures =
-        figures->draw({o.out_dir, title, o.snapshots, estimator_options.sensor.pose.translation});
-    outputs.adopt(o.out_dir / "plot_data.txt");
-    for (const auto& png : result.figures) {
-      outputs.adopt(png);
-      outputs.adopt(std::filesystem::path(png).replace_extension(".gp"));
-    }
+  if (o.figures) draw_figures(*figures, model, geometry, estimator_options, o, outputs, result);
+  if (o.warn_disagreement) {
+    const std::string warning = disagreement_warning(result);
+    if (!warning.empty()) std::cerr << "extwrench: warning: " << title << ": " << warning << "\n";
   }
   own_outputs.keep();
   return result;

@@ -13,6 +13,7 @@
 #include "extwrench/io/urdf_writer.hpp"
 #include "extwrench/sim/perturb.hpp"
 #include "progress.hpp"
+#include "summary_figure.hpp"
 
 namespace extwrench {
 namespace {
@@ -88,7 +89,8 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   Data data(model);
   const long total = simulator.num_samples();
   const std::string label = "seed " + std::to_string(r.seed);
-  detail::ProgressLine progress(progress_on, 256, std::chrono::milliseconds(200));
+  detail::ProgressLine progress(progress_on, 256, std::chrono::milliseconds(200), total);
+  bool above = false;
   while (simulator.next(sample)) {
     log.write(sample);
     if (singular_body > 0) {
@@ -98,10 +100,15 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
         r.peak_condition = c;
         r.peak_time = sample.t;
       }
+      // Every crossing, not only the highest: a periodic motion passes the singularity often.
+      if (c > s.singularity_threshold) {
+        if (!above) r.singular_spans.emplace_back(sample.t, sample.t);
+        r.singular_spans.back().second = sample.t;
+      }
+      above = c > s.singularity_threshold;
     }
     ++r.samples;
-    progress.update(r.samples, "%s: simulating %3.0f %%", label.c_str(),
-                    100.0 * static_cast<double>(r.samples) / static_cast<double>(total));
+    progress.update(r.samples, "%s: simulating", label.c_str());
   }
   progress.done();
   log.close();
@@ -120,14 +127,15 @@ std::vector<ReplayWindow> metric_windows(const Scenario& s, const SeedResult& r,
       {"after_transient", "t >= " + from + " s (after the residual's transient)", after});
   if (s.singularity_half_width > 0.0 && singular_body > 0) {
     sim::MetricsWindow outside = after;
-    outside.exclude.emplace_back(r.peak_time - s.singularity_half_width,
-                                 r.peak_time + s.singularity_half_width);
-    char buf[256];
+    for (const auto& [a, b] : r.singular_spans)
+      outside.exclude.emplace_back(a - s.singularity_half_width, b + s.singularity_half_width);
+    char buf[320];
     std::snprintf(buf, sizeof buf,
-                  "t >= %s s, excluding ±%g s around the peak of cond(J of O_l), l = %s (%.4g at "
-                  "t = %.3f s)",
-                  from.c_str(), s.singularity_half_width, s.singularity_link.c_str(),
-                  r.peak_condition, r.peak_time);
+                  "t >= %s s, excluding ±%g s around each of the %zu crossing(s) of cond(J of "
+                  "O_l) > %g, l = %s (peak %.4g at t = %.3f s)",
+                  from.c_str(), s.singularity_half_width, r.singular_spans.size(),
+                  s.singularity_threshold, s.singularity_link.c_str(), r.peak_condition,
+                  r.peak_time);
     windows.push_back({"outside_singularity", buf, outside});
   }
   return windows;
@@ -146,6 +154,8 @@ void replay_schemes(const Scenario& s, const std::vector<EstimatorConfig>& confi
     ro.windows = windows;
     ro.surface_metrics = s.surface_metrics;
     ro.figures = options.figures && s.figures;
+    ro.figure_format = options.figure_format;
+    ro.desired_trajectory = &s.trajectory;
     ro.progress = options.progress;
     ro.warn_ignored_columns = false;
     ro.outputs = &outputs;
@@ -181,7 +191,7 @@ SeedResult run_seed(const Scenario& s, std::uint64_t seed, const std::filesystem
 }  // namespace
 
 std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::path& out_dir,
-                                     const RunOptions& options) {
+                                     const RunOptions& options, RunSummary* summary) {
   const Model& model = s.robot.model;
   const int singular_body = s.singularity_link.empty() ? -1 : *model.find_body(s.singularity_link);
   if (!s.seeds.empty()) check_schemes(s, seed_dir(s, s.seeds.front(), out_dir));
@@ -190,6 +200,10 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
   std::vector<SeedResult> results;
   for (const std::uint64_t seed : s.seeds)
     results.push_back(run_seed(s, seed, out_dir, options, singular_body, outputs));
+  if (options.figures && s.figures && results.size() > 1) {
+    const auto figure = detail::draw_summary(s, results, out_dir, options.figure_format, outputs);
+    if (summary != nullptr && figure) summary->figure = *figure;
+  }
   outputs.keep();
   return results;
 }

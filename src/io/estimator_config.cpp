@@ -168,6 +168,13 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (!root["sensor"])
     rd.fail(root, "sensor", "missing (needs at least sensor.type: ft | force | none)");
   read_sensor(rd, root["sensor"], o.sensor);
+  // One rule everywhere (dynamics, simulate): without sensor.pose, the model's 'sensor' frame.
+  if (root["sensor"]["pose"]) {
+    cfg.sensor_pose_source = "sensor.pose";
+  } else {
+    o.sensor.pose = default_sensor_pose(model);
+    cfg.sensor_pose_source = describe_default_sensor_pose(model);
+  }
   if (root["contact"]) read_contact(rd, root["contact"], model, o.contact);
   if (root["observer"]) read_observer(rd, root["observer"], n, o);
   if (root["detection"]) read_detection(rd, root["detection"], n, o.detection);
@@ -206,6 +213,17 @@ std::string list3(const Vector3& v) {
 }
 
 }  // namespace
+
+std::string describe_default_sensor_pose(const Model& model) {
+  const std::string root =
+      "the root link's origin ('" + model.bodies[0].name + "'), aligned with it";
+  const auto frame = model.find_frame("sensor");
+  if (!frame) return root;
+  const Frame& f = model.frames[static_cast<std::size_t>(*frame)];
+  if (f.body == 0) return "the model's frame 'sensor'";
+  return root + " (the model's frame 'sensor' is on the moving body '" +
+         model.bodies[static_cast<std::size_t>(f.body)].name + "', not a base sensor)";
+}
 
 EstimatorConfig load_estimator_config(const std::filesystem::path& path,
                                       const LoadOptions& robot_options) {

@@ -51,6 +51,14 @@ void OutputFiles::commit(const fs::path& path) {
   committed_.push_back(path);
 }
 
+void OutputFiles::discard(const fs::path& path) {
+  const auto it = std::find(staged_.begin(), staged_.end(), path);
+  if (it == staged_.end()) return;
+  std::error_code ec;
+  fs::remove(partial_name(path), ec);
+  staged_.erase(it);
+}
+
 void OutputFiles::adopt(const fs::path& path) { committed_.push_back(path); }
 
 }  // namespace extwrench

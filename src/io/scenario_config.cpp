@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <string>
 
 #include "detail/yaml_reader.hpp"
@@ -100,10 +101,27 @@ void parse_sensors(const YamlReader& y, const YAML::Node& node, Scenario& s) {
     s.log_velocity = y.boolean(node["log_velocity"], "sensors.log_velocity");
 }
 
+// metrics.targets: {SCHEME: {force_rms: N, force_rms_outside: N, line_rms: m, right_link: %}};
+// the scheme names are checked once the schemes are read (check_targets).
+void parse_targets(const YamlReader& y, const YAML::Node& t, Scenario& s) {
+  if (!t.IsMap()) y.fail(t, "metrics.targets", "expected a map {scheme: {metric: value}}");
+  for (const auto& entry : t) {
+    const std::string scheme = y.string(entry.first, "metrics.targets");
+    const std::string k = "metrics.targets." + scheme;
+    if (!entry.second.IsMap()) y.fail(entry.second, k, "expected a map {metric: value}");
+    y.only_keys(entry.second, k, {"force_rms", "force_rms_outside", "line_rms", "right_link"});
+    for (const auto& m : entry.second) {
+      const std::string metric = y.string(m.first, k);
+      const double value = y.number_in(m.second, k + "." + metric, non_negative());
+      s.targets.push_back({scheme, metric, value, m.second.Mark().line + 1});
+    }
+  }
+}
+
 void parse_metrics(const YamlReader& y, const YAML::Node& node, Scenario& s) {
-  y.only_keys(
-      node, "metrics",
-      {"from", "exclude", "exclude_around_singularity", "singularity_link", "surface_point"});
+  y.only_keys(node, "metrics",
+              {"from", "exclude", "exclude_around_singularity", "singularity_link",
+               "singularity_threshold", "surface_point", "targets"});
   y.set_number_in(node, "metrics", "from", non_negative(), s.metrics_from);
   if (const YAML::Node ex = node["exclude"]) {
     if (!ex.IsSequence()) y.fail(ex, "metrics.exclude", "expected a list of [from, to] intervals");
@@ -116,6 +134,9 @@ void parse_metrics(const YamlReader& y, const YAML::Node& node, Scenario& s) {
   }
   y.set_number_in(node, "metrics", "exclude_around_singularity", non_negative(),
                   s.singularity_half_width);
+  y.set_number_in(node, "metrics", "singularity_threshold", {1, 1e300, true, "> 1"},
+                  s.singularity_threshold);
+  if (const YAML::Node t = node["targets"]) parse_targets(y, t, s);
   if (node["singularity_link"]) {
     s.singularity_link = y.string(node["singularity_link"], "metrics.singularity_link");
     (void)y.body(s.robot.model, node["singularity_link"], "metrics.singularity_link");
@@ -274,6 +295,14 @@ Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& rob
   default_singularity_link(y, root, s);
   if (root["figures"]) s.figures = y.boolean(root["figures"], "figures");
   parse_schemes(y, root, s);
+  for (const MetricTarget& t : s.targets) {
+    const bool known = std::any_of(s.schemes.begin(), s.schemes.end(),
+                                   [&](const SchemeSpec& x) { return x.name == t.scheme; });
+    if (!known) {
+      throw Error(y.file() + ":" + std::to_string(t.line) + ": metrics.targets." + t.scheme +
+                  ": no scheme of that name");
+    }
+  }
   return s;
 }
 

@@ -9,9 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "extwrench/app/gnuplot.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/metrics_json.hpp"
 #include "extwrench/io/output_files.hpp"
+#include "extwrench/sim/trajectory.hpp"
 
 namespace extwrench {
 
@@ -30,10 +32,18 @@ struct ReplayOptions {
   std::vector<ReplayWindow> windows;
   bool surface_metrics = false;  ///< report the surface-point error
   bool figures = true;
+  FigureFormat figure_format = FigureFormat::kPng;
+  /// The trajectory the log's controller tracked (simulate): q_d in the joint figure; or null.
+  const sim::SinusoidalTrajectory* desired_trajectory = nullptr;
   int plot_points = 2000;            ///< decimation target per figure
   int snapshots = 4;                 ///< instants of the 3-D view
   bool progress = false;             ///< progress line on stderr
   bool warn_ignored_columns = true;  ///< list unknown log columns once on stderr
+  /// Joint columns beyond the robot's n (q8 on a 7-joint robot) are an error unless this is set
+  /// (then they are ignored, with the note of warn_ignored_columns).
+  bool ignore_extra_joint_columns = false;
+  /// Warn on stderr when most contact samples carry `disagreement` (wrong sensor pose...).
+  bool warn_disagreement = true;
   /// The command's output transaction (a scenario run's); null: the replay is its own, kept
   /// when it succeeds. Either way a failed replay leaves no estimates.csv or metrics.json.
   OutputFiles* outputs = nullptr;
@@ -44,14 +54,30 @@ struct ReplayResult {
   bool has_truth = false;
   MetricsReport report;  ///< empty windows without truth
   std::vector<std::filesystem::path> figures;
+  std::vector<std::string> figure_failures;  ///< one per figure not drawn (warned on stderr)
+  long contact_samples = 0;                  ///< estimates with a contact declared
+  long disagreement_samples = 0;             ///< of those, flagged `disagreement`
+  /// disagreement_samples / contact_samples (0 without contact).
+  [[nodiscard]] double disagreement_fraction() const {
+    return contact_samples > 0
+               ? static_cast<double>(disagreement_samples) / static_cast<double>(contact_samples)
+               : 0.0;
+  }
 };
+
+/// The run-level warning of a replay whose contact samples mostly carry `disagreement` (the
+/// base sensor and the joint residual tell different stories), naming the likely causes; empty
+/// when there is nothing to warn about (fewer than half, or too few contact samples).
+[[nodiscard]] std::string disagreement_warning(const ReplayResult& result);
 
 /// Reads `options.log` row by row, runs a ContactEstimator built from (model, geometry,
 /// estimator) on it, writes out_dir/estimates.csv, and with truth columns out_dir/metrics.json;
 /// figures (PNG, gnuplot) unless disabled. The first row resets the estimator (its output row is
 /// "free" with a zero residual). Throws extwrench::Error on malformed logs (file, line, column)
-/// and when the log lacks the columns the configuration's sensor needs; a malformed row fails
-/// after every row before it was estimated, and leaves no output (estimates.csv is written as
+/// and when the log lacks the columns the configuration's sensor needs, or has joint columns
+/// beyond the robot's n (unless ignore_extra_joint_columns). A figure that cannot be drawn is a
+/// warning (figure_failures), never an error: the estimates and metrics stand; a malformed row
+/// fails after every row before it was estimated, and leaves no output (estimates.csv is written as
 /// estimates.csv.partial and renamed at the end; see OutputFiles).
 ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator, const ReplayOptions& options);

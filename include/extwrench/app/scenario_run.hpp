@@ -24,12 +24,22 @@ struct SeedResult {
   long samples = 0;
   double peak_condition = 0.0;  ///< max of cond(J of O_l) over the run (true q)
   double peak_time = 0.0;       ///< [s]
+  /// The crossings: time spans where cond(J of O_l) > the scenario's singularity_threshold.
+  std::vector<std::pair<double, double>> singular_spans;
   std::vector<SchemeResult> schemes;
 };
 
 struct RunOptions {
   bool figures = true;
   bool progress = false;
+  FigureFormat figure_format = FigureFormat::kPng;
+};
+
+/// The run's summary across seeds (several seeds, figures on): DIR/summary.<format> with its
+/// data and script, the force and line-of-action errors of every scheme per seed and the
+/// scenario's targets. Empty when not drawn; a failure is a warning on stderr (as a replay's).
+struct RunSummary {
+  std::filesystem::path figure;
 };
 
 /// Runs the scenario for every seed: DIR (one seed) or DIR/seed_<s> (several) receives
@@ -38,6 +48,10 @@ struct RunOptions {
 /// as `extwrench estimate`, with the configuration read back from <scheme>/config.yaml.
 [[nodiscard]] std::vector<SeedResult> run_scenario(const Scenario& scenario,
                                                    const std::filesystem::path& out_dir,
-                                                   const RunOptions& options);
+                                                   const RunOptions& options,
+                                                   RunSummary* summary = nullptr);
+
+/// The value of a target's metric in a scheme's results (NaN when the run has no such window).
+[[nodiscard]] double target_metric(const ReplayResult& replay, const std::string& metric);
 
 }  // namespace extwrench

@@ -4,7 +4,8 @@
 //   gravity: [0, 0, -9.81]            # [m/s^2], world frame; default: the robot file's
 //   sensor:
 //     type: ft                        # ft | force | none (required)
-//     pose: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # sensor frame in the robot's root frame
+//     pose: {xyz: [0, 0, 0], rpy: [0, 0, 0]}   # sensor frame in the robot's root frame;
+//                                     # default: the model's 'sensor' frame, else the root's
 //     tare: false                     # false | true (100 samples) | N samples
 //   contact:
 //     model: pure_force               # pure_force | known_point
@@ -36,7 +37,15 @@ struct EstimatorConfig {
   std::filesystem::path robot_path;  ///< resolved path of the robot file
   RobotDescription robot;            ///< loaded robot (gravity from the config applied)
   EstimatorOptions options;          ///< link names resolved to body indices, sizes checked
+  /// Where options.sensor.pose came from: "sensor.pose" when the file gives it, else the rule
+  /// of default_sensor_pose() in words (printed at the start of a replay).
+  std::string sensor_pose_source;
 };
+
+/// Which rule default_sensor_pose() (estimation/base_sensor.hpp) applies to `model`, in words
+/// for messages: "the model's frame 'sensor'" or "the root link's origin ('base'), aligned with
+/// it" (with the reason when a 'sensor' frame sits on a moving body).
+[[nodiscard]] std::string describe_default_sensor_pose(const Model& model);
 
 /// Reads a configuration file and loads its robot. Throws extwrench::Error naming file, line, key.
 [[nodiscard]] EstimatorConfig load_estimator_config(const std::filesystem::path& path,

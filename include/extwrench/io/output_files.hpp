@@ -24,8 +24,13 @@ class OutputFiles {
   std::filesystem::path stage(const std::filesystem::path& path);
   /// The staged file of `path` is complete: renames it to `path` (atomic, same directory).
   void commit(const std::filesystem::path& path);
+  /// The staged file of `path` is not wanted (a figure that failed): removes "<path>.partial"
+  /// now; the rest of the transaction is unaffected.
+  void discard(const std::filesystem::path& path);
   /// Registers a file written directly under its name (figures), to remove on rollback.
   void adopt(const std::filesystem::path& path);
+  /// The files committed or adopted so far (to hand a nested transaction's files to its parent).
+  [[nodiscard]] const std::vector<std::filesystem::path>& committed() const { return committed_; }
   /// The command succeeded: keep every file.
   void keep() { kept_ = true; }
 

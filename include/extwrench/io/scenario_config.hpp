@@ -22,6 +22,13 @@ struct SchemeSpec {
   int line = 0;      ///< where it is defined in the scenario
 };
 
+struct MetricTarget {
+  std::string scheme;
+  std::string metric;  ///< force_rms | force_rms_outside | line_rms | right_link
+  double value = 0.0;  ///< upper bound (right_link: lower bound, percent)
+  int line = 0;
+};
+
 struct Scenario {
   std::filesystem::path source;
   std::filesystem::path robot_path;
@@ -36,10 +43,15 @@ struct Scenario {
   // Metrics
   double metrics_from = 0.2;  ///< [s] start of every window (after the residual's transient)
   std::vector<std::pair<double, double>> metrics_exclude;
-  double singularity_half_width = 0.0;  ///< > 0: a second window excluding ± this around the peak
+  double singularity_half_width = 0.0;  ///< > 0: a second window excluding ± this around each
+                                        ///< crossing of cond(J of O_l) above the threshold
+  double singularity_threshold = 1e3;   ///< cond(J of O_l) above this is a crossing
   std::string
       singularity_link;  ///< link l whose cond(J of O_l) is tracked (default: first force's)
   bool surface_metrics = false;
+  /// metrics.targets: per scheme, the metric (force_rms, force_rms_outside, line_rms,
+  /// right_link [%]) and the value the scenario states it should reach (docs/simulation.md).
+  std::vector<MetricTarget> targets;
   bool figures = true;
   std::vector<SchemeSpec> schemes;
 };

@@ -1,0 +1,238 @@
+// `extwrench estimate` on what a robot records (a log without truth columns), as a new user
+// would run it on the paper scenario's log: every sensor type, the figures, the sensor-pose
+// rule, the disagreement warning, joint columns beyond the robot, and a figure failure that
+// must stay a warning (issue 11).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace extwrench {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSource = EXTWRENCH_SOURCE_DIR;
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+bool contains(const std::string& text, const std::string& needle) {
+  return text.find(needle) != std::string::npos;
+}
+
+struct CliRun {
+  int code = -1;
+  std::string out, err;
+};
+
+bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+// The CSV text with the columns whose names start with any of `prefixes` removed (the test's
+// own splitting: the logs written by simulate have no quoted cells).
+std::string drop_columns(const std::string& csv, const std::vector<std::string>& prefixes) {
+  std::istringstream in(csv);
+  std::string line, out;
+  std::vector<bool> keep;
+  while (std::getline(in, line)) {
+    std::vector<std::string> cells;
+    std::stringstream cs(line);
+    std::string cell;
+    while (std::getline(cs, cell, ',')) cells.push_back(cell);
+    if (!line.empty() && line.back() == ',') cells.emplace_back();
+    if (keep.empty()) {
+      for (const auto& c : cells) {
+        bool k = true;
+        for (const auto& p : prefixes) k = k && c.rfind(p, 0) != 0;
+        keep.push_back(k);
+      }
+    }
+    std::string row;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (i < keep.size() && keep[i]) row += (row.empty() ? "" : ",") + cells[i];
+    }
+    out += row + "\n";
+  }
+  return out;
+}
+
+// One short run of the paper scenario (through the singularity at t = 2 s) shared by the tests.
+class RealLog : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = fs::temp_directory_path() / ("extwrench_cli_replay_" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    std::string scenario = read_text(kSource / "scenarios" / "paper.yaml");
+    const auto replace = [&](const std::string& from, const std::string& to) {
+      const auto at = scenario.find(from);
+      ASSERT_NE(at, std::string::npos) << from;
+      scenario.replace(at, from.size(), to);
+    };
+    replace("robot: ../models/paper_arm.urdf",
+            "robot: " + (kSource / "models/paper_arm.urdf").string());
+    replace("seeds: [1, 2, 3, 4, 5]", "seeds: [1]");
+    replace("duration: 6.0", "duration: 2.5");
+    write_text(dir_ / "paper_short.yaml", scenario);
+    const CliRun r = run("simulate --no-figures '" + (dir_ / "paper_short.yaml").string() +
+                         "' --out '" + (dir_ / "sim").string() + "'");
+    ASSERT_EQ(r.code, 0) << r.err;
+    write_text(dir_ / "robot_log.csv", drop_columns(read_text(dir_ / "sim/log.csv"), {"true_"}));
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static CliRun run(const std::string& args, const std::string& env = "") {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string command = env + " '" + std::string(EXTWRENCH_CLI) + "' " + args + " >'" +
+                                out.string() + "' 2>'" + err.string() + "' </dev/null";
+    const int status = std::system(command.c_str());
+    return CliRun{WIFEXITED(status) ? WEXITSTATUS(status) : 128, read_text(out), read_text(err)};
+  }
+
+  // The scheme's configuration written by simulate, with `sensor:` replaced (robot path made
+  // absolute so that the file may live anywhere).
+  static fs::path config(const std::string& name, const std::string& sensor,
+                         const std::string& scheme = "ft") {
+    std::istringstream in(read_text(dir_ / "sim" / scheme / "config.yaml"));
+    std::string line, text;
+    while (std::getline(in, line)) {
+      if (line.rfind("robot:", 0) == 0)
+        line = "robot: " + (dir_ / "sim/model_estimator.urdf").string();
+      if (line.rfind("sensor:", 0) == 0 && !sensor.empty()) line = "sensor: " + sensor;
+      text += line + "\n";
+    }
+    write_text(dir_ / (name + ".yaml"), text);
+    return dir_ / (name + ".yaml");
+  }
+
+  static CliRun estimate(const fs::path& cfg, const std::string& out, const std::string& extra = "",
+                         const std::string& log = "robot_log.csv", const std::string& env = "") {
+    return run("estimate --config '" + cfg.string() + "' --log '" + (dir_ / log).string() +
+                   "' --out '" + (dir_ / out).string() + "' " + extra,
+               env);
+  }
+
+  static fs::path dir_;
+};
+
+fs::path RealLog::dir_;
+
+TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
+  const std::vector<std::pair<std::string, std::string>> types{
+      {"ft", "{type: ft, pose: {xyz: [0, 0, -0.31], rpy: [0, 0, 0]}}"},
+      {"force", "{type: force, pose: {xyz: [0, 0, -0.31], rpy: [0, 0, 0]}}"},
+      {"none", "{type: none}"}};
+  for (const auto& [type, sensor] : types) {
+    const CliRun r = estimate(config("cfg_" + type, sensor), "out_" + type);
+    ASSERT_EQ(r.code, 0) << type << ": " << r.err;
+    EXPECT_FALSE(contains(r.err, "warning")) << type << ": " << r.err;
+    for (const char* name : {"joints", "force", "line_point", "condition", "robot3d"}) {
+      const fs::path png = dir_ / ("out_" + type) / (std::string(name) + ".png");
+      ASSERT_TRUE(fs::exists(png)) << png;
+      // A PNG file, not an empty or half-written one: its signature and a plausible size.
+      EXPECT_EQ(read_text(png).substr(1, 3), "PNG") << png;
+      EXPECT_GT(fs::file_size(png), 10000u) << png;
+    }
+    for (const auto& f : fs::directory_iterator(dir_ / ("out_" + type)))
+      EXPECT_FALSE(contains(f.path().string(), ".partial")) << f.path();
+    EXPECT_FALSE(fs::exists(dir_ / ("out_" + type) / "metrics.json")) << "no truth, no metrics";
+  }
+  // Truth columns are not an input of the estimator: the same estimates with and without them.
+  const CliRun with_truth =
+      estimate(config("cfg_ft", types[0].second), "out_ft_truth", "--no-figures", "sim/log.csv");
+  ASSERT_EQ(with_truth.code, 0) << with_truth.err;
+  EXPECT_EQ(read_text(dir_ / "out_ft/estimates.csv"),
+            read_text(dir_ / "out_ft_truth/estimates.csv"));
+}
+
+TEST_F(RealLog, WithoutSensorPoseTheModelsSensorFrameIsUsedAndSaid) {
+  // The paper arm's model has a frame 'sensor' 0.31 m below the shoulder (models/paper_arm.urdf).
+  const CliRun given =
+      estimate(config("pose_given", "{type: ft, pose: {xyz: [0, 0, -0.31], rpy: [0, 0, 0]}}"),
+               "pose_given", "--no-figures");
+  const CliRun omitted =
+      estimate(config("pose_omitted", "{type: ft}"), "pose_omitted", "--no-figures");
+  ASSERT_EQ(given.code, 0) << given.err;
+  ASSERT_EQ(omitted.code, 0) << omitted.err;
+  EXPECT_TRUE(contains(omitted.out, "the model's frame 'sensor'")) << omitted.out;
+  EXPECT_TRUE(contains(given.out, "(sensor.pose)")) << given.out;
+  EXPECT_EQ(read_text(dir_ / "pose_given/estimates.csv"),
+            read_text(dir_ / "pose_omitted/estimates.csv"));
+  EXPECT_FALSE(contains(omitted.err, "disagreement")) << omitted.err;
+}
+
+TEST_F(RealLog, ASensorPoseTenCentimetresOffIsWarnedAbout) {
+  const CliRun off =
+      estimate(config("pose_off", "{type: ft, pose: {xyz: [0, 0, -0.21], rpy: [0, 0, 0]}}"),
+               "pose_off", "--no-figures");
+  ASSERT_EQ(off.code, 0) << off.err;  // a warning, not an error: the user may know better
+  EXPECT_TRUE(contains(off.err, "warning")) << off.err;
+  EXPECT_TRUE(contains(off.err, "disagreement")) << off.err;
+  EXPECT_TRUE(contains(off.err, "sensor pose")) << off.err;
+}
+
+TEST_F(RealLog, JointColumnsBeyondTheRobotAreAnErrorUnlessIgnoredOnPurpose) {
+  // An 8th joint appended to every row: the log of another robot, or a gripper's joint.
+  std::istringstream in(read_text(dir_ / "robot_log.csv"));
+  std::string line, text;
+  bool header = true;
+  while (std::getline(in, line)) {
+    text += line + (header ? ",q8,dq8,tau8\n" : ",0.1,0,0\n");
+    header = false;
+  }
+  write_text(dir_ / "eight_joints.csv", text);
+  const fs::path cfg = config("cfg_extra", "{type: none}", "no_sensor");
+  const CliRun refused = estimate(cfg, "extra_refused", "--no-figures", "eight_joints.csv");
+  EXPECT_EQ(refused.code, 1);
+  EXPECT_TRUE(contains(refused.err, "q8, dq8, tau8")) << refused.err;
+  EXPECT_TRUE(contains(refused.err, "--ignore-extra-joints")) << refused.err;
+  EXPECT_FALSE(fs::exists(dir_ / "extra_refused/estimates.csv"));
+  const CliRun ignored =
+      estimate(cfg, "extra_ignored", "--no-figures --ignore-extra-joints", "eight_joints.csv");
+  EXPECT_EQ(ignored.code, 0) << ignored.err;
+  EXPECT_TRUE(fs::exists(dir_ / "extra_ignored/estimates.csv"));
+}
+
+TEST_F(RealLog, AFigureThatCannotBeDrawnIsAWarningAndLeavesNoPartialFile) {
+  // No gnuplot on the PATH: every figure fails; the estimates stand and the exit code is 0.
+  const CliRun r = estimate(config("cfg_nognuplot", "{type: ft}"), "no_gnuplot", "",
+                            "robot_log.csv", "PATH=/nonexistent");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "figure not drawn")) << r.err;
+  EXPECT_TRUE(contains(r.err, "gnuplot not found")) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "no_gnuplot/estimates.csv"));
+  for (const auto& f : fs::directory_iterator(dir_ / "no_gnuplot")) {
+    EXPECT_FALSE(contains(f.path().string(), ".partial")) << f.path();
+    EXPECT_NE(f.path().extension(), ".png") << f.path();
+  }
+}
+
+TEST_F(RealLog, SvgAndPdfFiguresOnRequest) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
+  const CliRun svg = estimate(config("cfg_svg", "{type: ft}"), "svg", "--figure-format svg");
+  ASSERT_EQ(svg.code, 0) << svg.err;
+  EXPECT_TRUE(contains(read_text(dir_ / "svg/condition.svg"), "<svg"));
+  const CliRun pdf = estimate(config("cfg_pdf", "{type: ft}"), "pdf", "--figure-format pdf");
+  ASSERT_EQ(pdf.code, 0) << pdf.err;
+  EXPECT_EQ(read_text(dir_ / "pdf/robot3d.pdf").substr(0, 5), "%PDF-");
+  EXPECT_EQ(estimate(config("cfg_bad", "{type: ft}"), "bad", "--figure-format jpg").code, 2);
+}
+
+}  // namespace
+}  // namespace extwrench
