@@ -237,7 +237,14 @@ std::string robot3d_script(const PlotContext& c, const Figure& f, const Robot3dI
   for (std::size_t k = 0; k < shots.size(); ++k) {
     char t[64];
     std::snprintf(t, sizeof t, "t = %.3f s", in.rows.row(shots[k])[kT]);
-    const auto title = [&](const char* text) {
+    const auto has = [&](bool mesh) {
+      if (in.geometry == nullptr) return false;
+      return std::any_of(
+          in.geometry->shapes.begin(), in.geometry->shapes.end(),
+          [&](const CollisionShape& x) { return (x.type == ShapeType::kMesh) == mesh; });
+    };
+    const auto title = [&](const char* text, bool shown = true) {
+      if (!shown) return std::string("''");
       return k == 0 ? gnuplot_quote(text) : std::string("''");
     };
     const int i = kBlocks * static_cast<int>(k);
@@ -247,13 +254,13 @@ std::string robot3d_script(const PlotContext& c, const Figure& f, const Robot3dI
       << "splot 'robot3d.txt' index " << i
       << " with linespoints lw 3 pt 7 ps 0.8 lc rgb '#555555' title "
       << title("links (sensor, joint origins)") << ", '' index " << i + 1
-      << " with lines lw 1 lc rgb '#8c8c8c' title " << title("collision shapes") << ", '' index "
-      << i + 2 << " with dots lc rgb '#9a9a9a' title " << title("meshes (vertices)")
-      << ", '' index " << i + 3 << " with points pt 7 ps 1.6 lc rgb '#d62728' title "
-      << title("true point") << ", '' index " << i + 4 << " with lines lw 3 lc rgb '#1f77b4' title "
-      << title("line of action") << ", '' index " << i + 5
-      << " with points pt 9 ps 1.8 lc rgb '#2ca02c' title " << title("estimated point")
-      << ", '' index " << i + 6
+      << " with lines lw 1 lc rgb '#8c8c8c' title " << title("collision shapes", has(false))
+      << ", '' index " << i + 2 << " with dots lc rgb '#9a9a9a' title "
+      << title("meshes (vertices)", has(true)) << ", '' index " << i + 3
+      << " with points pt 7 ps 1.6 lc rgb '#d62728' title " << title("true point") << ", '' index "
+      << i + 4 << " with lines lw 3 lc rgb '#1f77b4' title " << title("line of action")
+      << ", '' index " << i + 5 << " with points pt 9 ps 1.8 lc rgb '#2ca02c' title "
+      << title("estimated point") << ", '' index " << i + 6
       << " using 1:2:3:4:5:6 with vectors head filled lw 3 lc rgb '#ff7f0e' title " << title(arrow)
       << ", '' index " << i + 7
       << " using 1:2:3:4:5:6 with vectors head empty dt 2 lw 2 lc rgb '#d62728' title "
