@@ -18,7 +18,7 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kBlocks = 8;            // data blocks (gnuplot indices) per snapshot
 constexpr int kCircleSegments = 24;   // polygon of a drawn circle
-constexpr int kMeshPoints = 400;      // vertices drawn per mesh, at most
+constexpr int kMeshTriangles = 300;   // triangles drawn per mesh, at most (every k-th)
 constexpr double kArrowLength = 0.3;  // [m] of the largest force drawn
 
 // The extent of everything written, for the axes' ranges.
@@ -109,7 +109,7 @@ void primitive(Writer& w, const CollisionShape& shape, const Pose& X) {
   }
 }
 
-// Blocks 1 and 2 of a snapshot: the primitives' wireframes, the meshes' vertex clouds.
+// Blocks 1 and 2 of a snapshot: the primitives' wireframes, outlines of the meshes' triangles.
 void shapes_blocks(Writer& w, const GeometryModel* geometry, const Data& data) {
   bool any = false;
   for (const CollisionShape& s : geometry ? geometry->shapes : std::vector<CollisionShape>{}) {
@@ -122,9 +122,16 @@ void shapes_blocks(Writer& w, const GeometryModel* geometry, const Data& data) {
   for (const CollisionShape& s : geometry ? geometry->shapes : std::vector<CollisionShape>{}) {
     if (s.type != ShapeType::kMesh || !s.mesh) continue;
     const Pose X = data.X_WB[static_cast<std::size_t>(s.body)] * s.placement;
-    const Eigen::Index count = s.mesh->vertices.cols();
-    const Eigen::Index step = std::max<Eigen::Index>(1, (count + kMeshPoints - 1) / kMeshPoints);
-    for (Eigen::Index i = 0; i < count; i += step) w.point(X.act(s.mesh->vertices.col(i)));
+    // A sample of the triangles as outlines: unlike vertices (at a tube's ends only), their
+    // edges follow the whole surface.
+    const auto& v = s.mesh->vertices;
+    const Eigen::Index count = s.mesh->triangles.cols();
+    const Eigen::Index step =
+        std::max<Eigen::Index>(1, (count + kMeshTriangles - 1) / kMeshTriangles);
+    for (Eigen::Index t = 0; t < count; t += step) {
+      for (int k = 0; k <= 3; ++k) w.point(X.act(v.col(s.mesh->triangles(k % 3, t))));
+      w.end_line();
+    }
     any = true;
   }
   any ? w.end_block() : w.empty_block();
@@ -255,8 +262,8 @@ std::string robot3d_script(const PlotContext& c, const Figure& f, const Robot3dI
       << " with linespoints lw 3 pt 7 ps 0.8 lc rgb '#555555' title "
       << title("links (sensor, joint origins)") << ", '' index " << i + 1
       << " with lines lw 1 lc rgb '#8c8c8c' title " << title("collision shapes", has(false))
-      << ", '' index " << i + 2 << " with dots lc rgb '#9a9a9a' title "
-      << title("meshes (vertices)", has(true)) << ", '' index " << i + 3
+      << ", '' index " << i + 2 << " with lines lw 0.5 lc rgb '#b0b0b0' title "
+      << title("meshes (sampled triangles)", has(true)) << ", '' index " << i + 3
       << " with points pt 7 ps 1.6 lc rgb '#d62728' title " << title("true point") << ", '' index "
       << i + 4 << " with lines lw 3 lc rgb '#1f77b4' title " << title("line of action")
       << ", '' index " << i + 5 << " with points pt 9 ps 1.8 lc rgb '#2ca02c' title "

@@ -1,5 +1,5 @@
 // The replay's 3-D view: the robot at a few instants (contact instants first) with its links'
-// collision shapes (primitives as wireframes, meshes as clouds of their vertices), the estimated
+// collision shapes (primitives as wireframes, meshes as sampled triangle outlines), the estimated
 // force as an arrow at its point, the line of action, the estimated and the true point. Private
 // to the app library.
 #pragma once
