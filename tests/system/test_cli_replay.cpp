@@ -88,10 +88,18 @@ class RealLog : public ::testing::Test {
             "robot: " + (kSource / "models/paper_arm.urdf").string());
     replace("seeds: [1, 2, 3, 4, 5]", "seeds: [1]");
     replace("duration: 6.0", "duration: 2.5");
+    // The paper's acceptance (docs/simulation.md) as the scenario's targets.
+    replace("  singularity_link: link6",
+            "  singularity_link: link6\n  targets: {ft: {force_rms: 1.0, line_rms: 0.02, "
+            "right_link: 99}, no_sensor: {force_rms_outside: 3.0}}");
     write_text(dir_ / "paper_short.yaml", scenario);
     const CliRun r = run("simulate --no-figures '" + (dir_ / "paper_short.yaml").string() +
                          "' --out '" + (dir_ / "sim").string() + "'");
     ASSERT_EQ(r.code, 0) << r.err;
+    simulate_out_ = r.out;
+    const auto bad = scenario.find("no_sensor: {force_rms_outside");
+    ASSERT_NE(bad, std::string::npos);
+    write_text(dir_ / "bad_target.yaml", scenario.replace(bad, 9, "nosuch   "));
     write_text(dir_ / "robot_log.csv", drop_columns(read_text(dir_ / "sim/log.csv"), {"true_"}));
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
@@ -128,9 +136,26 @@ class RealLog : public ::testing::Test {
   }
 
   static fs::path dir_;
+  static std::string simulate_out_;
 };
 
 fs::path RealLog::dir_;
+std::string RealLog::simulate_out_;
+
+TEST_F(RealLog, TheScenariosTargetsArePrintedWithTheirVerdict) {
+  for (const char* line : {"ft           target force_rms <= 1: worst ",
+                           "ft           target line_rms <= 0.02: worst ",
+                           "ft           target right_link >= 99: worst 100  met",
+                           "no_sensor    target force_rms_outside <= 3: worst "}) {
+    EXPECT_TRUE(contains(simulate_out_, line)) << line << "\n" << simulate_out_;
+  }
+  EXPECT_FALSE(contains(simulate_out_, "NOT MET")) << simulate_out_;
+  const CliRun bad = run("simulate --no-figures '" + (dir_ / "bad_target.yaml").string() +
+                         "' --out '" + (dir_ / "bad").string() + "'");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_TRUE(contains(bad.err, "metrics.targets.nosuch: no scheme of that name")) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "bad"));
+}
 
 TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
   if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
