@@ -50,8 +50,8 @@ TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {
   EXPECT_EQ(c.options.sensor.type, SensorType::kNone);
   // Without sensor.pose: the model's frame 'sensor', 0.31 m below O_0 in models/paper_arm.urdf
   // (its <joint name="sensor_joint">), as `dynamics` and scenarios take it.
-  EXPECT_TRUE(c.options.sensor.pose.is_approx(
-      Pose{Matrix3::Identity(), Vector3(0, 0, -0.31)}, 1e-12));
+  EXPECT_TRUE(
+      c.options.sensor.pose.is_approx(Pose{Matrix3::Identity(), Vector3(0, 0, -0.31)}, 1e-12));
   EXPECT_EQ(c.sensor_pose_source, "the model's frame 'sensor'");
   EXPECT_EQ(c.options.sensor.tare_samples, 0);
   EXPECT_EQ(c.options.contact.model, ContactModel::kPureForce);
