@@ -6,8 +6,11 @@ SANITIZE_BUILD ?= build-sanitize
 BENCH_BUILD ?= build-release
 RELEASE_BUILD ?= build-install
 PREFIX ?= /usr/local
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 600
+FUZZ_HARNESSES ?= urdf dh_yaml estimator_config scenario csv_log estimator
 
-.PHONY: all build test test-sanitize demo bench install format clean
+.PHONY: all build test test-sanitize fuzz-build fuzz demo bench install format clean
 
 all: build
 
@@ -27,6 +30,19 @@ test-sanitize:
 	cmake --build $(SANITIZE_BUILD) -j $(JOBS)
 	cd $(SANITIZE_BUILD) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j $(JOBS)
+	$(MAKE) fuzz-build
+	cd $(FUZZ_BUILD) && ctest -L fuzz --output-on-failure -j $(JOBS)
+
+# The libFuzzer harnesses of fuzz/ (clang, everything instrumented; docs/testing.md "Fuzzing").
+fuzz-build:
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+	  -DEXTWRENCH_BUILD_FUZZERS=ON -DEXTWRENCH_BUILD_TESTS=OFF -DEXTWRENCH_BUILD_CLI=OFF \
+	  -DEXTWRENCH_BUILD_EXAMPLES=OFF
+	cmake --build $(FUZZ_BUILD) -j $(JOBS) --target $(addprefix fuzz_,$(FUZZ_HARNESSES))
+
+# Each harness fuzzed for FUZZ_SECONDS in turn (default 600 s); prints executions per harness.
+fuzz: fuzz-build
+	bash fuzz/run.sh $(FUZZ_BUILD) $(FUZZ_SECONDS) $(FUZZ_HARNESSES)
 
 # The main job builds only what it runs: the CLI (not the tests, benchmarks, examples).
 demo: $(BUILD)/CMakeCache.txt
@@ -55,4 +71,4 @@ format:
 	clang-format -i $$(git ls-files '*.hpp' '*.cpp')
 
 clean:
-	rm -rf $(BUILD) $(SANITIZE_BUILD) $(BENCH_BUILD)
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(BENCH_BUILD) $(FUZZ_BUILD)
