@@ -76,20 +76,19 @@ const RobotDescription& robot() {
   return r;
 }
 
-// Sensor type, acceleration route, contact model and tare from one byte.
+// Sensor type, acceleration route, contact model and tare from one byte. The sensor frame is the
+// root frame and the known point the link's origin (the defaults).
 std::optional<ContactEstimator> make_estimator(std::uint8_t config) {
   const Model& model = robot().model;
   EstimatorOptions o;
   constexpr SensorType kTypes[] = {SensorType::kNone, SensorType::kForce, SensorType::kForceTorque,
                                    SensorType::kForceTorque};
   o.sensor.type = kTypes[config & 3];
-  o.sensor.pose.translation = Vector3(0.0, 0.0, -0.3);
   o.sensor.tare_samples = (config & 0x10) != 0 ? 3 : 0;
   if ((config & 4) != 0) o.acceleration = AccelerationRoute::kDifferentiation;
   if ((config & 8) != 0) {
     o.contact.model = ContactModel::kKnownPoint;
     o.contact.link = model.nq() - 1;
-    o.contact.point = Vector3(0.0, 0.0, 0.05);
   }
   if ((config & 0x20) != 0) o.observer_gain = VectorX::Constant(model.nq(), 25.0);
   try {
