@@ -11,6 +11,9 @@ packages=(
   # assimp's CMake targets link libz.so, which libassimp-dev does not pull in.
   zlib1g-dev
   gnuplot-nox
+  # The fuzz harnesses (make fuzz, make test-sanitize): clang, and its libFuzzer and sanitizer
+  # runtimes, which clang-14 only recommends.
+  clang libclang-rt-14-dev
 )
 missing=()
 for p in "${packages[@]}"; do
