@@ -171,6 +171,16 @@ void register_contact_benchmarks() {
           [panda, &tr, c](benchmark::State& state) {
             run_update(state, panda->model, panda->geometry, options_for(c, tr), tr);
           });
+      // The paper's isolation rule on the same meshes: the cost of geometry isolation (issue 9)
+      // is the ratio of the two in the same binary.
+      benchmark::RegisterBenchmark(
+          (std::string("BM_FullUpdate_Ours/") + c.name + "/panda_meshes/residual_isolation")
+              .c_str(),
+          [panda, &tr, c](benchmark::State& state) {
+            EstimatorOptions o = options_for(c, tr);
+            o.isolation.rule = IsolationRule::kResidual;
+            run_update(state, panda->model, panda->geometry, o, tr);
+          });
     }
   }
   // Latency distributions: our full F/T unknown-point update, and KDL's estimator for contrast.

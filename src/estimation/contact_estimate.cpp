@@ -42,6 +42,9 @@ std::string describe_flags(std::uint32_t flags) {
       {EstimateFlag::kBaseOnly, "base_only"},
       {EstimateFlag::kTaring, "taring"},
       {EstimateFlag::kLinkMismatch, "link_mismatch"},
+      {EstimateFlag::kAmbiguous, "ambiguous"},
+      {EstimateFlag::kResidualIsolation, "residual_isolation"},
+      {EstimateFlag::kPartial, "partial"},
   };
   std::string out;
   for (const auto& e : kNames) {

@@ -32,6 +32,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
       geometry_(std::move(geometry)),
       observer_(model_, options_.observer_gain),
       detector_(options_.detection, model_.nq()),
+      isolation_ws_(model_),
       n_(model_.nq()),
       differentiation_(options_.acceleration == AccelerationRoute::kDifferentiation),
       need_ddq_(options_.sensor.type != SensorType::kNone || differentiation_) {
@@ -42,6 +43,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
                 std::to_string(geometry_.body_shapes.size()) + " bodies, the model " +
                 std::to_string(model_.num_bodies()));
   }
+  isolation_rule_ = resolved_rule(options_.isolation, geometry_);
   nominal_inertia_.reserve(model_.bodies.size());
   for (const Body& b : model_.bodies) nominal_inertia_.push_back(b.inertia);
   if (options_.friction) observer_.set_friction(*options_.friction);
@@ -58,6 +60,8 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   tau_pred_ = VectorX::Zero(n_);
   tau_eff_ = VectorX::Zero(n_);
   J_ = Matrix6X::Zero(6, n_);
+  dforce_dddq_.setZero(3, n_);
+  minv_jvt_.setZero(n_, 3);
   out_.residual = VectorX::Zero(n_);
 }
 
@@ -75,6 +79,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   disagreement_on_ = false;
   have_disagreement_edge_ = false;
   spectrum_.size = 0;  // a reset run matches a fresh estimator's bit for bit
+  release_link_ = -1;
   if (options_.sensor.tare_samples > 0) {
     tare_.bias_S.setZero();
     tare_.request(options_.sensor.tare_samples);
@@ -307,15 +312,23 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
   if (has_sensor) base = base_sensor_reading(reading_S, flags);  // 5
   // 6. Detection.
   const double base_force = has_sensor && !base.taring ? base.force_W.norm() : kNaN;
-  const DetectionResult& det = detector_.update(t, tau_ext_, base_force);
+  const double release_force = has_sensor && !base.taring && release_link_ >= 0
+                                   ? sensor_release_force(base)
+                                   : ContactDetector::kNoReleaseForce;
+  const DetectionResult& det = detector_.update(t, tau_ext_, base_force, release_force);
   out_.contact = det.contact;
   flags |= detection_flags(det);
   // 7. Isolation.
-  const int link = isolate(det, options_.contact.model, options_.contact.link, flags);
+  int link = isolate(det, options_.contact.model, options_.contact.link, flags);
+  if (link >= 0 && isolation_rule_ == IsolationRule::kGeometry &&
+      options_.contact.model == ContactModel::kPureForce && out_.status.ok()) {
+    link = geometric_isolation(link, base, flags);
+  }
   if (has_sensor) {
     out_.force_W = base.force_W;
     flags |= EstimateFlag::kForce;
   }
+  release_link_ = det.contact && link >= 0 ? link : -1;
   if (link < 0) {
     out_.flags = flags;
     disagreement_on_ = false;
@@ -327,6 +340,7 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
   if (out_.status.ok()) fit = table_one_case(link, base, flags);  // 8
   contact_point(link, fit, det.contact, flags);                   // 9
   consistency(t, link, det.contact, fit, flags);
+  release_point_L_ = out_.point_L.allFinite() ? out_.point_L : Vector3::Zero();
   out_.flags = flags;
 }
 
@@ -342,6 +356,29 @@ BaseWrench ContactEstimator::base_sensor_reading(const Vector6& reading_S,
   return base;
 }
 
+// 7b. In: l_r of the paper's rule, the base wrench, τ̂_ext, data_ (poses). Out: the link chosen
+// among l_r … n by the residual and the shapes (isolation.hpp), out_.link_candidates, and
+// kAmbiguous or kResidualIsolation in `flags`.
+int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& base,
+                                          std::uint32_t& flags) noexcept {
+  IsolationInputs in;
+  in.sensor = options_.sensor.type;
+  in.residual_link = residual_link;
+  in.tau_ext = &tau_ext_;
+  in.tau_min = &detector_.tau_min();
+  in.base = &base;
+  in.p_WS = options_.sensor.pose.translation;
+  const IsolationResult r = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
+                                                options_.solver, isolation_ws_);
+  if (!r.decided) {
+    flags |= EstimateFlag::kResidualIsolation;
+    return residual_link;
+  }
+  out_.link_candidates = r.candidates & ~(std::uint64_t{1} << r.link);
+  if (r.ambiguous) flags |= EstimateFlag::kAmbiguous;
+  return r.link;
+}
+
 // 8. In: the isolated link, the base wrench of stage 5, data_ (poses). Out: J_ = J_l of O_l,
 // the fit of the sensor's Table I case; out_.condition_number, out_.force_W (case E) and the
 // kForce, kIllConditioned, kUnobservable flags.
@@ -349,9 +386,8 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
                                            std::uint32_t& flags) noexcept {
   const Vector3& O_l = data_.X_WB[static_cast<std::size_t>(link)].translation;
   point_jacobian(model_, data_, link, O_l, J_);  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l
-  const WrenchFit fit =
-      wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
-                  options_.sensor.pose.translation, options_.solver, b_, spectrum_);
+  WrenchFit fit = wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
+                              options_.sensor.pose.translation, options_.solver, b_, spectrum_);
   if (options_.sensor.type != SensorType::kForceTorque) out_.condition_number = fit.condition;
   if (fit.fitted_force) {
     out_.force_W = fit.force_W;
@@ -359,7 +395,35 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
   }
   if (fit.damped) flags |= EstimateFlag::kIllConditioned;
   if (!fit.ok) flags |= EstimateFlag::kUnobservable;
+  if (!fit.ok && options_.contact.model == ContactModel::kKnownPoint &&
+      options_.sensor.type == SensorType::kNone)
+    known_point_force(link, fit, flags);
+  if (fit.partial) {
+    flags |= EstimateFlag::kPartial;
+    out_.observable_basis_W = fit.basis_W;
+    out_.observable_rank = fit.rank;
+  }
   return fit;
+}
+
+// 8b. Known point, no sensor, rank J_l < 6 (a short chain): the force alone at p (M_ext taken
+// as 0), J_v,pᵀ F = τ̂, minimum-norm on its observable subspace (docs/estimator.md#partial-
+// observability). Out: fit.force_W, its basis, out_.force_W and kForce.
+void ContactEstimator::known_point_force(int link, WrenchFit& fit, std::uint32_t& flags) noexcept {
+  const Pose& X_WL = data_.X_WB[static_cast<std::size_t>(link)];
+  point_jacobian(model_, data_, link, X_WL.act(options_.contact.point), J_);
+  Vector3 x;
+  Matrix3 basis;
+  const int rank =
+      min_norm_solve<3>(J_.topRows<3>(), link, tau_ext_, options_.solver.rank_tolerance, x, basis);
+  if (rank == 0) return;
+  fit.force_W = x;
+  fit.partial = true;
+  fit.rank = rank;
+  fit.basis_W.setZero();
+  fit.basis_W.topLeftCorner<3, 3>() = basis;
+  out_.force_W = x;
+  flags |= EstimateFlag::kForce;
 }
 
 // 9. In: the link, the fit, the declared contact, data_ (X_WL). Out: with a known point, the
@@ -376,6 +440,12 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
     flags |= EstimateFlag::kKnownPoint;
     if (fit.ok) {
       out_.moment_W = known_point_moment(fit, p_W, O_l);
+      flags |= EstimateFlag::kMoment;
+    } else if (fit.partial && options_.sensor.type == SensorType::kForce) {
+      // Case D's observable part: M = P (M̄ − r_{l,p} × F), P the projector on the observable
+      // moment directions (the minimum-norm M, not the minimum-norm M̄ shifted).
+      const auto B = fit.basis_W.block<3, 3>(3, 3);
+      out_.moment_W = fit.moment_O - B * (B.transpose() * (p_W - O_l).cross(fit.force_W));
       flags |= EstimateFlag::kMoment;
     }
   } else if (fit.ok && contact) {

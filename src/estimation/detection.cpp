@@ -47,11 +47,13 @@ void ContactDetector::reset() noexcept {
   declared_ = false;
   have_edge_ = false;
   last_link_ = -1;
+  rearm_ = false;
   result_ = DetectionResult{};
 }
 
 const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const VectorX>& tau_ext,
-                                               double base_force_norm) noexcept {
+                                               double base_force_norm,
+                                               double release_force_norm) noexcept {
   const double ratio = options_.release_ratio;
   int link = -1;
   for (Eigen::Index i = 0; i < tau_min_.size(); ++i) {
@@ -68,7 +70,19 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
   }
   const bool base_only = base_over_ && link < 0;
   if (base_only) link = 0;  // a contact no joint feels is on link 0 (Sec. II-B)
-  const bool raw = link >= 0;
+  bool raw = link >= 0;
+  const bool over = raw;
+  // The sensor says the force is gone: release without waiting for the residual's decay.
+  if (declared_ && std::isfinite(release_force_norm) &&
+      !(release_force_norm > ratio * options_.f_min)) {
+    raw = false;
+  }
+  if (rearm_) {  // after a sensor release, a new onset needs every threshold to have dropped
+    if (over)
+      raw = false;
+    else
+      rearm_ = false;
+  }
 
   // Debounce both edges: the raw state must hold for min_duration before it is declared.
   if (raw != declared_) {
@@ -79,6 +93,7 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
     if (t - edge_time_ >= options_.min_duration - kTimeSlack) {
       declared_ = raw;
       have_edge_ = false;
+      if (!raw && over) rearm_ = true;
     }
   } else {
     have_edge_ = false;

@@ -37,6 +37,12 @@ void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   if (!(o.solver.rank_tolerance > 0.0 && o.solver.rank_tolerance < 1.0)) {
     throw Error(where + ": solver.rank_tolerance: expected a value in (0, 1)");
   }
+  if (!(o.isolation.tolerance > 0.0) || !std::isfinite(o.isolation.tolerance)) {
+    throw Error(where + ": isolation.tolerance: expected a finite value > 0");
+  }
+  if (!(o.isolation.ambiguity_distance >= 0.0) || !std::isfinite(o.isolation.ambiguity_distance)) {
+    throw Error(where + ": isolation.ambiguity_distance: expected a finite value >= 0 [m]");
+  }
 }
 
 }  // namespace

@@ -130,6 +130,23 @@ void read_payload(const YamlReader& rd, const YAML::Node& p, const Model& model,
   o.payload = pl;
 }
 
+// isolation: residual | geometry, or {rule: residual | geometry, tolerance, ambiguity_distance}.
+void read_isolation(const YamlReader& rd, const YAML::Node& node, IsolationOptions& o) {
+  const auto rule = [&](const YAML::Node& r, const std::string& key) {
+    return rd.one_of(r, key, {"residual", "geometry"}) == 0 ? IsolationRule::kResidual
+                                                            : IsolationRule::kGeometry;
+  };
+  if (node.IsScalar()) {
+    o.rule = rule(node, "isolation");
+    return;
+  }
+  rd.only_keys(node, "isolation", {"rule", "tolerance", "ambiguity_distance"});
+  if (node["rule"]) o.rule = rule(node["rule"], "isolation.rule");
+  rd.set_number_in(node, "isolation", "tolerance", {0, 1e9, true, "> 0 (x tau_min)"}, o.tolerance);
+  rd.set_number_in(node, "isolation", "ambiguity_distance", {0, 1e9, false, ">= 0 [m]"},
+                   o.ambiguity_distance);
+}
+
 void read_solver(const YamlReader& rd, const YAML::Node& s, SolverOptions& o) {
   rd.only_keys(s, "solver", {"max_condition", "rank_tolerance"});
   rd.set_number_in(s, "solver", "max_condition", {1, 1e300, true, "> 1"}, o.max_condition);
@@ -158,7 +175,7 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (!root.IsDefined() || root.IsNull()) rd.fail(root, "(top level)", "empty configuration");
   rd.only_keys(root, "",
                {"robot", "gravity", "sensor", "contact", "observer", "detection", "acceleration",
-                "friction", "payload", "solver"});
+                "friction", "payload", "solver", "isolation"});
   EstimatorConfig cfg;
   cfg.source = source;
   read_robot(rd, root, source, robot_options, cfg);
@@ -182,6 +199,7 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (root["friction"]) read_friction(rd, root["friction"], n, o);
   if (root["payload"]) read_payload(rd, root["payload"], model, o);
   if (root["solver"]) read_solver(rd, root["solver"], o.solver);
+  if (root["isolation"]) read_isolation(rd, root["isolation"], o.isolation);
 
   // The remaining checks need the whole picture (serial chain, sizes).
   try {
@@ -287,6 +305,17 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   }
   y << "solver: {max_condition: " << o.solver.max_condition
     << ", rank_tolerance: " << o.solver.rank_tolerance << "}\n";
+  // Written only when set, so that a configuration without it reads back to the same default
+  // (geometry when the robot has collision shapes).
+  const IsolationOptions defaults;
+  const IsolationOptions& iso = o.isolation;
+  if (iso.rule || iso.tolerance != defaults.tolerance ||
+      iso.ambiguity_distance != defaults.ambiguity_distance) {
+    y << "isolation: {";
+    if (iso.rule) y << "rule: " << to_string(*iso.rule) << ", ";
+    y << "tolerance: " << iso.tolerance << ", ambiguity_distance: " << iso.ambiguity_distance
+      << "}\n";
+  }
   return y.str();
 }
 

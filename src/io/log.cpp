@@ -251,6 +251,7 @@ std::vector<std::string> estimates_columns(int n) {
   std::vector<std::string> c{"t",  "contact", "link", "fx", "fy", "fz", "mx",     "my",  "mz",
                              "px", "py",      "pz",   "lx", "ly", "lz", "status", "cond"};
   for (const auto& r : numbered("r", n)) c.push_back(r);
+  c.push_back("link_candidates");  // issue 9: appended, so the older columns keep their places
   return c;
 }
 }  // namespace
@@ -278,6 +279,20 @@ std::string EstimatesWriter::status_text(const ContactEstimate& e) {
   return describe_flags(e.flags);
 }
 
+// The other consistent links by name, '|'-separated; empty when there are none.
+void EstimatesWriter::write_candidates(std::uint64_t candidates) {
+  if (candidates != cached_candidates_) {
+    cached_candidates_ = candidates;
+    cached_candidates_text_.clear();
+    for (std::size_t l = 0; l < body_names_.size() && l < 64; ++l) {
+      if ((candidates >> l & 1u) == 0) continue;
+      if (!cached_candidates_text_.empty()) cached_candidates_text_ += '|';
+      cached_candidates_text_ += body_names_[l];
+    }
+  }
+  csv_.add(std::string_view(cached_candidates_text_));
+}
+
 void EstimatesWriter::write(const ContactEstimate& e) {
   csv_.add(e.t);
   csv_.add(e.contact ? 1 : 0);
@@ -301,6 +316,7 @@ void EstimatesWriter::write(const ContactEstimate& e) {
   for (int i = 0; i < n_; ++i) {
     csv_.add(e.residual.size() == n_ ? e.residual[i] : std::nan(""));
   }
+  write_candidates(e.link_candidates);
   csv_.end_row();
 }
 

@@ -5,52 +5,19 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "reference/kdl_reference.hpp"
+#include "reference/panda_chain.hpp"
 
 namespace extwrench {
 namespace {
 
 using test::SeededRng;
 
-const std::filesystem::path kUrdf =
-    std::filesystem::path(EXTWRENCH_SHARED_DIR) /
-    "models/franka_panda/urdf_example-robot-data/urdf/panda.relative.urdf";
-
-/// Replaces every occurrence of `from` (plain text; <regex> trips a false GCC 12 warning at -O1).
-std::string replace_all(std::string text, const std::string& from, const std::string& to) {
-  for (std::size_t at = text.find(from); at != std::string::npos;
-       at = text.find(from, at + to.size())) {
-    text.replace(at, from.size(), to);
-  }
-  return text;
-}
-
-/// Removes every self-closing element `<tag .../>`.
-std::string remove_elements(std::string text, const std::string& tag) {
-  for (std::size_t at = text.find("<" + tag); at != std::string::npos;
-       at = text.find("<" + tag, at)) {
-    text.erase(at, text.find("/>", at) + 2 - at);
-  }
-  return text;
-}
-
-/// The Panda as a 7-joint chain: the finger joints become fixed (merged into the hand), mesh
-/// paths made absolute so the string loads from anywhere.
-RobotDescription panda_chain() {
-  std::ifstream in(kUrdf);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string xml = ss.str();
-  xml = remove_elements(xml, "mimic");
-  xml = replace_all(xml, R"(type="prismatic")", R"(type="fixed")");
-  xml = replace_all(xml, R"(filename="../)", "filename=\"" + kUrdf.parent_path().string() + "/../");
-  return load_urdf_string(xml, kUrdf.string());
-}
+using test::panda_chain;
+const std::filesystem::path kUrdf = test::panda_urdf();
 
 TEST(PandaMeshContact, PushingPointIsNeverConfusedWithThePullingOne) {
   if (!std::filesystem::exists(kUrdf)) GTEST_SKIP() << "shared models absent";

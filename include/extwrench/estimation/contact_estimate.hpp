@@ -54,6 +54,13 @@ struct EstimateFlag {
       1u << 13;  ///< sensor bias being estimated: sensor detection off
   static constexpr std::uint32_t kLinkMismatch =
       1u << 14;  ///< known-point link differs from the isolated link
+  // Bits 20+: issue 9 (geometry-consistent isolation).
+  static constexpr std::uint32_t kAmbiguous =
+      1u << 20;  ///< another consistent candidate link is met as early along the line
+  static constexpr std::uint32_t kResidualIsolation =
+      1u << 21;  ///< geometry isolation could test no candidate: the paper's rule decided
+  static constexpr std::uint32_t kPartial =
+      1u << 22;  ///< rank deficient: the observable part only (observable_basis), rest zero
 };
 
 /// Names of the set bits, separated by '|' ("contact|force|line|surface_point"); "free" for 0.
@@ -78,6 +85,14 @@ struct ContactEstimate {
       Vector3::Constant(kNaN);  ///< p̂ of eq. (20): point of the line nearest O_l [m]
   Vector3 line_direction_W = Vector3::Constant(kNaN);  ///< unit F̂/‖F̂‖
   double surface_distance = kNaN;  ///< 0 when the line meets the link; > 0 when it misses [m]
+  /// Geometry isolation: bit l set for every other link l consistent with the residual and the
+  /// line of action (the chosen link excluded); 0 otherwise.
+  std::uint64_t link_candidates = 0;
+  /// kPartial: orthonormal basis (first observable_rank columns) of the observable subspace of
+  /// the unknowns solved, as 6-vectors (F [N]; M̄ [N m] about O_l) in W; the reported force (and,
+  /// for a known point, moment) is the minimum-norm solution within it.
+  Eigen::Matrix<double, 6, 6> observable_basis_W = Eigen::Matrix<double, 6, 6>::Zero();
+  int observable_rank = -1;  ///< dimension of that subspace; −1 when not partial
   VectorX residual;  ///< τ̂_ext (n) used for isolation: r, or RNEA − τ (differentiation route)
   double condition_number =
       kNaN;       ///< σ_max/σ_min of the Jacobian inverted (cases D, E), SI units; NaN when none

@@ -109,6 +109,9 @@ class ContactEstimator {
   void estimate(double t, const Vector6& reading_S) noexcept;  // stages 5–9
   BaseWrench base_sensor_reading(const Vector6& reading_S, std::uint32_t& flags) noexcept;
   WrenchFit table_one_case(int link, const BaseWrench& base, std::uint32_t& flags) noexcept;
+  double sensor_release_force(const BaseWrench& base) noexcept;
+  void known_point_force(int link, WrenchFit& fit, std::uint32_t& flags) noexcept;
+  int geometric_isolation(int residual_link, const BaseWrench& base, std::uint32_t& flags) noexcept;
   void contact_point(int link, const WrenchFit& fit, bool contact, std::uint32_t& flags) noexcept;
   void consistency(double t, int link, bool contact, const WrenchFit& fit,
                    std::uint32_t& flags) noexcept;
@@ -128,6 +131,8 @@ class ContactEstimator {
   GeometryModel geometry_;
   MomentumObserver observer_;
   ContactDetector detector_;
+  IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
+  IsolationWorkspace isolation_ws_;
   int n_ = 0;
   bool differentiation_ = false;  ///< route (a)
   bool need_ddq_ = false;         ///< q̈̂ needed: a sensor, or route (a)
@@ -141,11 +146,15 @@ class ContactEstimator {
   SensorTare tare_;
   bool disagreement_on_ = false, have_disagreement_edge_ = false;
   double disagreement_edge_ = 0.0;
+  int release_link_ = -1;  ///< contact link of the last sample (−1: none), for the release
+  Vector3 release_point_L_ = Vector3::Zero();  ///< its contact point (link frame), else O_l
   SpectrumGuess spectrum_;  ///< of J Jᵀ at the last damped solve (cases D, E); size 0 after reset
 
   // Scratch, sized once.
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;
   Matrix6X J_;
+  Eigen::Matrix<double, 3, Eigen::Dynamic> dforce_dddq_;  ///< ∂f̃_g/∂q̈ (3×n), release force
+  Eigen::Matrix<double, Eigen::Dynamic, 3> minv_jvt_;     ///< B⁻¹ J_vᵀ (n×3), release force
   ContactEstimate out_;
   // LDLᵀ of B(q) for q̈̂ with storage inside the object (up to kInlineJoints joints): the
   // fixed-capacity factorisation and solves are faster than the dynamic-size ones in Data.

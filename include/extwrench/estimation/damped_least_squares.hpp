@@ -172,4 +172,36 @@ inline DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, int cols, const
   return info;
 }
 
+/// The observable part of a rank-deficient J x = J b... system (J: R×n, first `cols` columns):
+/// with J Jᵀ = V Λ Vᵀ and the kept directions λ_i > (rank_tolerance · σ_max)², the minimum-norm
+/// solution x = Σ_kept v_i (v_iᵀ J b) / λ_i of Jᵀ x = b and the orthonormal basis of the kept
+/// directions (the first `rank` columns of `basis`). Components of x outside that subspace are
+/// not observable (zero here). Returns the rank (0: nothing observable, x zero). Fixed-size
+/// eigensolver: no allocation.
+template <int R, typename Derived, typename VectorB>
+inline int min_norm_solve(const Eigen::MatrixBase<Derived>& J, int cols, const VectorB& b,
+                          double rank_tolerance, Eigen::Matrix<double, R, 1>& x,
+                          Eigen::Matrix<double, R, R>& basis) noexcept {
+  using MatR = Eigen::Matrix<double, R, R>;
+  using VecR = Eigen::Matrix<double, R, 1>;
+  MatR A;
+  A.noalias() = J.leftCols(cols) * J.leftCols(cols).transpose();
+  VecR y;
+  y.noalias() = J.leftCols(cols) * b.head(cols);
+  const Eigen::SelfAdjointEigenSolver<MatR> eig(A);
+  const VecR& lambda = eig.eigenvalues();  // increasing
+  const double floor = rank_tolerance * rank_tolerance * std::max(lambda[R - 1], 0.0);
+  x.setZero();
+  basis.setZero();
+  int rank = 0;
+  if (!(lambda[R - 1] > 0.0) || eig.info() != Eigen::Success) return 0;
+  for (int i = R - 1; i >= 0; --i) {
+    if (!(lambda[i] > floor)) break;
+    const VecR v = eig.eigenvectors().col(i);
+    x += v * (v.dot(y) / lambda[i]);
+    basis.col(rank++) = v;
+  }
+  return rank;
+}
+
 }  // namespace extwrench

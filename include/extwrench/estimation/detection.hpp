@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include "extwrench/core/types.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
@@ -47,8 +48,14 @@ class ContactDetector {
 
   void reset() noexcept;
   /// τ̂_ext (n) and ‖F̂_ext‖ (NaN when there is no usable base force) at time t. No allocation.
+  /// release_force_norm: the sensor's instantaneous force (docs/estimator.md#release-from-the-
+  /// sensor), NaN when unknown. When finite, a declared contact is released once it falls below
+  /// release_ratio × f_min, however slowly τ̂_ext decays; a new onset then waits until every
+  /// joint and the base force have fallen below their release levels (one rising edge each).
   const DetectionResult& update(double t, const Eigen::Ref<const VectorX>& tau_ext,
-                                double base_force_norm) noexcept;
+                                double base_force_norm,
+                                double release_force_norm = kNoReleaseForce) noexcept;
+  static constexpr double kNoReleaseForce = std::numeric_limits<double>::quiet_NaN();
   [[nodiscard]] const DetectionResult& result() const noexcept { return result_; }
   [[nodiscard]] const VectorX& tau_min() const noexcept { return tau_min_; }
   [[nodiscard]] const DetectionOptions& options() const noexcept { return options_; }
@@ -62,6 +69,7 @@ class ContactDetector {
   bool have_edge_ = false;  ///< edge_time_ is valid
   double edge_time_ = 0.0;  ///< when the raw detection last changed against `declared_`
   int last_link_ = -1;
+  bool rearm_ = false;  ///< released by the sensor while thresholds were still over
   DetectionResult result_;
 };
 

@@ -8,6 +8,7 @@
 #include "extwrench/estimation/contact_estimate.hpp"
 #include "extwrench/estimation/damped_least_squares.hpp"
 #include "extwrench/estimation/detection.hpp"
+#include "extwrench/estimation/isolation.hpp"
 #include "extwrench/model/model.hpp"
 #include "extwrench/observer/friction.hpp"
 
@@ -36,6 +37,7 @@ struct EstimatorOptions {
   ContactOptions contact;
   VectorX observer_gain = VectorX::Constant(1, 100.0);  ///< K [1/s], size 1 or n
   DetectionOptions detection;
+  IsolationOptions isolation;  ///< which rule picks the contact link (isolation.hpp)
   AccelerationRoute acceleration = AccelerationRoute::kResidual;
   double differentiation_cutoff = 50.0;   ///< [Hz] low-pass of the differentiated q̇ (route (a))
   std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction

@@ -25,17 +25,53 @@ struct WrenchFit {
   bool damped = false;        ///< damped least squares active (cases D, E)
   bool fitted_force = false;  ///< F̂ comes from the fit (case E), not the sensor
   double condition = std::numeric_limits<double>::quiet_NaN();  ///< κ of the inverted Jacobian
+  /// Rank test failed (cases D, E): force_W / moment_O hold the minimum-norm solution on the
+  /// observable subspace (ok stays false: no line of action), basis_W its orthonormal basis in
+  /// (F; M̄) coordinates, first `rank` columns.
+  bool partial = false;
+  int rank = 0;
+  Eigen::Matrix<double, 6, 6> basis_W = Eigen::Matrix<double, 6, 6>::Zero();
 };
+
+/// Case D's observable part: the sensor's force (all of F) and the observable moment directions.
+template <typename Jacobian>
+inline void partial_moment(const Jacobian& J, int link, const VectorX& b, double rank_tolerance,
+                           WrenchFit& fit) noexcept {
+  Vector3 x;
+  Matrix3 basis;
+  const int r = min_norm_solve<3>(J.template bottomRows<3>(), link, b, rank_tolerance, x, basis);
+  fit.moment_O = x;
+  fit.partial = true;
+  fit.basis_W.setZero();
+  fit.basis_W.template topLeftCorner<3, 3>().setIdentity();
+  fit.basis_W.template block<3, 3>(3, 3) = basis;
+  fit.rank = 3 + r;
+}
+
+/// Case E's observable part: the minimum-norm wrench (F̂; M̄) on the observable subspace.
+template <typename Jacobian>
+inline void partial_wrench(const Jacobian& J, int link, const VectorX& tau_ext,
+                           double rank_tolerance, WrenchFit& fit) noexcept {
+  Vector6 x;
+  Eigen::Matrix<double, 6, 6> basis;
+  fit.rank = min_norm_solve<6>(J, link, tau_ext, rank_tolerance, x, basis);
+  fit.force_W = x.head<3>();
+  fit.moment_O = x.tail<3>();
+  fit.basis_W = basis;
+  fit.partial = true;
+}
 
 /// Table I case stage. In: the sensor type, J = J_l (6×n), l, τ̂_ext (n), the base wrench
 /// (F̂, n_m − ñ_g of base_wrench; unused for kNone), O_l, the sensor origin p_WS, the solver
-/// options. Scratch: b (n), the spectrum guess of the damped solves. Out: the fit.
+/// options. Scratch: b (n), the spectrum guess of the damped solves. Out: the fit; when the rank
+/// test fails and observable_part, its observable part (partial_moment, partial_wrench).
 template <typename Jacobian>
 [[nodiscard]] inline WrenchFit wrench_case(SensorType type, const Jacobian& J, int link,
                                            const VectorX& tau_ext, const BaseWrench& base,
                                            const Vector3& O_l, const Vector3& p_WS,
                                            const SolverOptions& solver, VectorX& b,
-                                           SpectrumGuess& guess) noexcept {
+                                           SpectrumGuess& guess,
+                                           bool observable_part = true) noexcept {
   WrenchFit fit;
   if (type == SensorType::kForceTorque) {
     // C (17): M̃ = n_m − ñ_g − r_{s,l} × F̂, the moment about O_l.
@@ -54,6 +90,8 @@ template <typename Jacobian>
       fit.moment_O = x;
       fit.ok = true;
       fit.damped = info.damped;
+    } else if (observable_part && link > 0 && base.force_W.allFinite()) {
+      partial_moment(J, link, b, solver.rank_tolerance, fit);
     }
   } else {
     // E (27): W̄ = (J_lᵀ)# τ̂_1:l, rank J_l = 6 required.
@@ -66,6 +104,9 @@ template <typename Jacobian>
       fit.ok = true;
       fit.damped = info.damped;
       fit.fitted_force = true;
+    } else if (observable_part && link > 0) {
+      partial_wrench(J, link, tau_ext, solver.rank_tolerance, fit);
+      fit.fitted_force = fit.rank > 0;
     }
   }
   return fit;

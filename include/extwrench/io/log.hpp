@@ -86,7 +86,9 @@ class LogWriter {
 };
 
 /// The estimates file: t, contact, link, fx fy fz, mx my mz, px py pz, lx ly lz, status, cond,
-/// r1..rn (world frame; quantities not estimated are empty cells; round-trip precision).
+/// r1..rn, link_candidates (world frame; quantities not estimated are empty cells; round-trip
+/// precision). link_candidates: the other links geometry isolation found consistent, by name,
+/// '|'-separated (docs/estimator.md#geometry-consistent-isolation).
 class EstimatesWriter {
  public:
   /// `model` gives n and the body names of the link column.
@@ -105,6 +107,9 @@ class EstimatesWriter {
   // The status text of the last ok row: flags change rarely, describe_flags() allocates.
   std::uint32_t cached_flags_ = 0;
   std::string cached_status_;
+  std::uint64_t cached_candidates_ = 0;
+  std::string cached_candidates_text_;
+  void write_candidates(std::uint64_t candidates);
 };
 
 }  // namespace extwrench

@@ -1,0 +1,125 @@
+#include "extwrench/estimation/isolation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/estimation/wrench_cases.hpp"
+#include "extwrench/geometry/ray.hpp"
+
+namespace extwrench {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// True when the single wrench (F̂, M̄) on the candidate reproduces τ̂_ext on every joint within
+/// its tolerance (zero torque expected beyond the candidate: J is zero there).
+bool predicts_residual(const Matrix6X& J, const WrenchFit& fit, const VectorX& tau_ext,
+                       const VectorX& tolerance, VectorX& tau_pred) noexcept {
+  Vector6 w;
+  w << fit.force_W, fit.moment_O;
+  tau_pred.noalias() = J.transpose() * w;
+  for (Eigen::Index i = 0; i < tau_pred.size(); ++i) {
+    if (!(std::abs(tau_pred[i] - tau_ext[i]) <= tolerance[i])) return false;
+  }
+  return true;
+}
+
+/// One tested candidate: where its line enters its shapes (abscissa u·p), or how far it misses.
+struct CandidateHit {
+  bool hit = false;
+  double abscissa = kInf;  ///< u·p_entry [m]: smaller is met first by a pusher coming along u
+};
+
+CandidateHit test_candidate(const Model& model, const Data& data, const GeometryModel& geometry,
+                            int l, const IsolationInputs& in, const SolverOptions& solver,
+                            IsolationWorkspace& ws, bool& consistent) noexcept {
+  consistent = false;
+  CandidateHit out;
+  const Pose& X_WL = data.X_WB[static_cast<std::size_t>(l)];
+  const Vector3& O_l = X_WL.translation;
+  point_jacobian(model, data, l, O_l, ws.J);
+  const WrenchFit fit = wrench_case(in.sensor, ws.J, l, *in.tau_ext, *in.base, O_l, in.p_WS, solver,
+                                    ws.b, ws.guess[static_cast<std::size_t>(l)], false);
+  if (!fit.ok || !predicts_residual(ws.J, fit, *in.tau_ext, ws.tolerance, ws.tau_pred)) return out;
+  Vector3 p_W, u_W;
+  if (!line_of_action(fit, O_l, p_W, u_W)) return out;
+  consistent = true;
+  const SurfacePointResult res = intersect_line_with_body(geometry, l, X_WL, p_W, u_W);
+  if (res.hit) {
+    out.hit = true;
+    out.abscissa = u_W.dot(res.entry.point_W);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string_view to_string(IsolationRule r) noexcept {
+  switch (r) {
+    case IsolationRule::kResidual:
+      return "residual";
+    case IsolationRule::kGeometry:
+      return "geometry";
+  }
+  return "unknown";
+}
+
+IsolationRule resolved_rule(const IsolationOptions& options,
+                            const GeometryModel& geometry) noexcept {
+  if (options.rule) return *options.rule;
+  const bool any_shape = std::any_of(geometry.body_shapes.begin(), geometry.body_shapes.end(),
+                                     [](const std::vector<int>& s) { return !s.empty(); });
+  return any_shape ? IsolationRule::kGeometry : IsolationRule::kResidual;
+}
+
+IsolationWorkspace::IsolationWorkspace(const Model& model)
+    : J(Matrix6X::Zero(6, model.nq())),
+      b(VectorX::Zero(model.nq())),
+      tau_pred(VectorX::Zero(model.nq())),
+      tolerance(VectorX::Zero(model.nq())),
+      guess(static_cast<std::size_t>(model.num_bodies())) {}
+
+IsolationResult isolate_on_geometry(const Model& model, const Data& data,
+                                    const GeometryModel& geometry, const IsolationInputs& in,
+                                    const IsolationOptions& options, const SolverOptions& solver,
+                                    IsolationWorkspace& ws) noexcept {
+  IsolationResult res;
+  res.link = in.residual_link;
+  if (in.residual_link < 0) return res;
+  ws.tolerance = options.tolerance * *in.tau_min;
+  // Candidate links are bodies l_r … last; at most 64 fit the candidate mask.
+  const int last =
+      std::min({model.num_bodies() - 1, static_cast<int>(geometry.body_shapes.size()) - 1, 63});
+  CandidateHit best;
+  int best_link = -1;
+  // Abscissae of the consistent hits, to judge ambiguity once the best is known.
+  double abscissa[64];
+  for (int l = in.residual_link; l <= last; ++l) {
+    abscissa[l] = kInf;
+    if (geometry.body_shapes[static_cast<std::size_t>(l)].empty()) continue;
+    bool consistent = false;
+    const CandidateHit c = test_candidate(model, data, geometry, l, in, solver, ws, consistent);
+    if (!consistent) continue;
+    res.candidates |= std::uint64_t{1} << l;
+    if (c.hit) {
+      abscissa[l] = c.abscissa;
+      if (!best.hit || c.abscissa < best.abscissa) {
+        best = c;
+        best_link = l;
+      }
+    }
+  }
+  // No consistent line meets a candidate's shapes: geometry has no say, the paper's rule stands.
+  if (best_link < 0) return res;
+  res.link = best_link;
+  res.decided = true;
+  for (int l = in.residual_link; l <= last; ++l) {
+    if (l != best_link && abscissa[l] - best.abscissa <= options.ambiguity_distance)
+      res.ambiguous = true;
+  }
+  return res;
+}
+
+}  // namespace extwrench

@@ -1,0 +1,126 @@
+// Issue 9, acceptance 2: the rank rules stay honest. A 2-joint planar chain (axes along z) with
+// a known contact point and no sensor gets its in-plane force (the torques are those of the
+// planar lever arms, written out here by hand), the out-of-plane component is flagged
+// unobservable, and nothing the rank forbids (a moment, a line of action) is reported.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "extwrench/estimation/contact_estimator.hpp"
+#include "extwrench/model/model_builder.hpp"
+
+namespace extwrench {
+namespace {
+
+constexpr double kL1 = 0.4, kL2 = 0.3;  // [m] link lengths
+
+Model planar_two_link() {
+  ModelBuilder b;
+  b.set_name("planar2");
+  Inertia in;
+  in.mass = 1.0;
+  in.com = Vector3(0.1, 0, 0);
+  in.inertia_com = Matrix3::Identity() * 0.01;
+  for (const char* name : {"base", "upper", "lower"}) {
+    LinkSpec link;
+    link.name = name;
+    link.inertia = in;
+    link.source = "test";
+    b.add_link(link);
+  }
+  JointSpec j1;
+  j1.name = "j1";
+  j1.parent = "base";
+  j1.child = "upper";
+  j1.axis = Vector3::UnitZ();
+  j1.source = "test";
+  JointSpec j2;
+  j2.name = "j2";
+  j2.parent = "upper";
+  j2.child = "lower";
+  j2.axis = Vector3::UnitZ();
+  j2.origin.translation = Vector3(kL1, 0, 0);
+  j2.source = "test";
+  b.add_joint(j1);
+  b.add_joint(j2);
+  return b.build();
+}
+
+/// τ_i = (z × (p − o_i)) · F for the planar chain at q, the point at (kL2, 0, h) of link 2.
+VectorX planar_torques(const VectorX& q, double h, const Vector3& F, Vector3& p_W) {
+  const Vector3 o2(kL1 * std::cos(q[0]), kL1 * std::sin(q[0]), 0);
+  p_W = o2 + Vector3(kL2 * std::cos(q[0] + q[1]), kL2 * std::sin(q[0] + q[1]), h);
+  VectorX tau(2);
+  tau[0] = Vector3::UnitZ().cross(p_W).dot(F);
+  tau[1] = Vector3::UnitZ().cross(p_W - o2).dot(F);
+  return tau;
+}
+
+TEST(PartialObservability, PlanarChainWithAKnownPointGetsItsInPlaneForce) {
+  const Model model = planar_two_link();
+  ASSERT_EQ(model.nq(), 2);
+  EstimatorOptions opt;
+  opt.sensor.type = SensorType::kNone;
+  opt.contact.model = ContactModel::kKnownPoint;
+  opt.contact.link = 2;
+  opt.contact.point = Vector3(kL2, 0, 0.05);
+  opt.detection.min_duration = 0.0;
+  ContactEstimator est(model, GeometryModel{}, opt);
+  const VectorX zero = VectorX::Zero(2);
+  double t = 0.0, worst = 0.0;
+  for (int k = 0; k < 50; ++k) {
+    VectorX q(2);
+    q << -1.5 + 0.06 * k, 0.3 + 0.04 * k;  // away from the stretched arm (q2 = 0)
+    const Vector3 F(12.0 * std::cos(0.3 * k), 12.0 * std::sin(0.3 * k), 7.0 - 0.2 * k);
+    Vector3 p_W;
+    const VectorX tau_ext = planar_torques(q, 0.05, F, p_W);
+    t += 1e-3;
+    ASSERT_TRUE(est.update_with(t, q, zero, zero, tau_ext, zero, Vector6::Zero()).ok());
+    const ContactEstimate& e = est.result();
+    ASSERT_TRUE(e.contact) << k;
+    EXPECT_TRUE(e.has(EstimateFlag::kPartial)) << describe_flags(e.flags);
+    EXPECT_TRUE(e.has(EstimateFlag::kUnobservable)) << describe_flags(e.flags);
+    EXPECT_TRUE(e.has(EstimateFlag::kForce));
+    EXPECT_FALSE(e.has(EstimateFlag::kMoment));  // M_ext is not observable at all
+    EXPECT_FALSE(e.moment_W.allFinite());
+    EXPECT_LT((e.point_W - p_W).norm(), 1e-12);
+    const double in_plane = (e.force_W.head<2>() - F.head<2>()).norm() / F.head<2>().norm();
+    worst = std::max(worst, in_plane);
+    EXPECT_LT(in_plane, 0.01) << k;
+    // The observable subspace is the plane: rank 2, basis (F; 0) with no z component.
+    ASSERT_EQ(e.observable_rank, 2);
+    for (int c = 0; c < 2; ++c) {
+      EXPECT_NEAR(e.observable_basis_W.col(c).norm(), 1.0, 1e-12);
+      EXPECT_NEAR(e.observable_basis_W(2, c), 0.0, 1e-9);
+      EXPECT_NEAR(e.observable_basis_W.col(c).tail<3>().norm(), 0.0, 1e-15);
+    }
+    EXPECT_NEAR(e.force_W.z(), 0.0, 1e-9);  // minimum norm: nothing claimed out of plane
+  }
+  std::printf("planar 2R, known point: worst in-plane force error %.2e (relative)\n", worst);
+}
+
+TEST(PartialObservability, PureForceOnAShortChainReportsNoLineNorPoint) {
+  const Model model = planar_two_link();
+  EstimatorOptions opt;
+  opt.sensor.type = SensorType::kNone;
+  opt.detection.min_duration = 0.0;
+  ContactEstimator est(model, GeometryModel{}, opt);
+  VectorX q(2);
+  q << 0.2, 0.9;
+  Vector3 p_W;
+  const VectorX tau_ext = planar_torques(q, 0.0, Vector3(3, 15, 0), p_W);
+  const VectorX zero = VectorX::Zero(2);
+  ASSERT_TRUE(est.update_with(0.001, q, zero, zero, tau_ext, zero, Vector6::Zero()).ok());
+  const ContactEstimate& e = est.result();
+  ASSERT_TRUE(e.contact);
+  EXPECT_TRUE(e.has(EstimateFlag::kPartial));
+  EXPECT_TRUE(e.has(EstimateFlag::kUnobservable));
+  EXPECT_FALSE(e.has(EstimateFlag::kLineOfAction));
+  EXPECT_FALSE(e.point_W.allFinite());
+  EXPECT_FALSE(e.line_point_W.allFinite());
+  EXPECT_EQ(e.observable_rank, 2);
+  EXPECT_TRUE(e.force_W.allFinite());  // the force part of the minimum-norm wrench
+}
+
+}  // namespace
+}  // namespace extwrench
