@@ -34,6 +34,9 @@ struct Scenario {
   double speed = 1.0;            ///< scales the trajectory's frequencies
   double tau_min = 1.0;          ///< detection threshold (default of DetectionOptions)
   double kp = 100.0, kd = 20.0;  ///< the tracking controller's PD gains [1/s², 1/s]
+  /// The contact points here are anywhere in the link frame, mostly off its capsules: the
+  /// paper's rule (geometry isolation needs points on the surface: test_geometry_isolation).
+  IsolationRule isolation = IsolationRule::kResidual;
 };
 
 struct Sample {
@@ -92,6 +95,7 @@ void run(const Scenario& s, Visit&& visit) {
   opt.observer_gain = VectorX::Constant(1, s.gain);
   opt.acceleration = s.route;
   opt.detection.tau_min = VectorX::Constant(1, s.tau_min);
+  opt.isolation.rule = s.isolation;
   ContactEstimator est(perturbed, test::paper_arm_capsules(perturbed), opt);
   VectorX tau = tracker.torque(perturbed, ctrl, 0.0, arm.q, arm.dq);
   ASSERT_TRUE(est.reset(0.0, arm.q, arm.dq, tau).ok());
