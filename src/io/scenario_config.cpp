@@ -158,6 +158,7 @@ void parse_robot(const YamlReader& y, const YAML::Node& root, const LoadOptions&
   LoadOptions options = robot_options;
   if (root["locked_joints"]) y.locked_joints(root["locked_joints"], "locked_joints", options);
   s.robot = load_robot(s.robot_path, options);
+  s.robot_options = options;
 }
 
 // seed: 3 or seeds: [1, 2, 3].

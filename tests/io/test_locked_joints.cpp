@@ -84,7 +84,9 @@ TEST(LockedJoints, TheReducedTreeEqualsTheUrdfWithThoseJointsFixed) {
     const auto ui = static_cast<std::size_t>(i);
     EXPECT_EQ(a.bodies[ui].name, b.bodies[ui].name);
     expect_same_inertia(a.bodies[ui].inertia, b.bodies[ui].inertia, a.bodies[ui].name);
-    if (i > 0) EXPECT_TRUE(a.joints[ui].placement.is_approx(b.joints[ui].placement, 1e-14));
+    if (i > 0) {
+      EXPECT_TRUE(a.joints[ui].placement.is_approx(b.joints[ui].placement, 1e-14));
+    }
   }
   // The fingers' mass is in the last body: the hand's, composed with them.
   EXPECT_NEAR(a.bodies.back().inertia.mass, 1.0 + 0.5 + 0.05 + 0.04, 1e-12);
