@@ -33,7 +33,6 @@ struct Robot {
 std::vector<Robot> robots() {
   std::vector<Robot> out;
   out.push_back({"paper arm", test::paper_arm_model()});
-  out.push_back({"random chain", random_chain({.n = 7, .seed = 30})});
   LoadOptions o;
   o.load_meshes = false;
   o.use_ros_package_path = false;
