@@ -39,9 +39,18 @@ void register_simulate(CLI::App& app);
 /// Adds `--package-path DIR` (repeatable) for package:// URIs to a subcommand.
 void add_package_path_option(CLI::App& sub, std::vector<std::filesystem::path>& dirs);
 
-/// Loads a URDF or DH YAML with those package directories (and ROS_PACKAGE_PATH).
-[[nodiscard]] RobotDescription load_robot_file(
-    const std::filesystem::path& path, const std::vector<std::filesystem::path>& package_path);
+/// Adds `--lock NAME=VALUE` (repeatable): joints held fixed at VALUE [rad | m] (a tree's extra
+/// branches, a gripper's fingers), LoadOptions::locked_joints.
+void add_lock_option(CLI::App& sub, std::vector<std::string>& locks);
+
+/// LoadOptions from --package-path and --lock; throws UsageError for a --lock that is not
+/// NAME=VALUE with a finite number, or a joint locked twice.
+[[nodiscard]] LoadOptions robot_load_options(const std::vector<std::filesystem::path>& package_path,
+                                             const std::vector<std::string>& locks);
+
+/// Loads a URDF or DH YAML with those options (package directories, ROS_PACKAGE_PATH, locks).
+[[nodiscard]] RobotDescription load_robot_file(const std::filesystem::path& path,
+                                               const LoadOptions& options);
 
 /// The base sensor pose X_WS used when none is given: the frame named "sensor" if the model
 /// has one (it must be on link 0), else the root link's origin, aligned with it.

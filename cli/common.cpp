@@ -51,11 +51,34 @@ void add_package_path_option(CLI::App& sub, std::vector<std::filesystem::path>& 
       ->type_name("DIR");
 }
 
-RobotDescription load_robot_file(const std::filesystem::path& path,
-                                 const std::vector<std::filesystem::path>& package_path) {
-  check_input_file(path, "robot", kMaxTextFileBytes);
+void add_lock_option(CLI::App& sub, std::vector<std::string>& locks) {
+  sub.add_option("--lock", locks,
+                 "Hold joint NAME fixed at VALUE [rad | m] (repeatable): a tree's extra branches "
+                 "(e.g. a gripper's fingers) merge into their parent link, leaving a serial chain")
+      ->type_name("NAME=VALUE");
+}
+
+LoadOptions robot_load_options(const std::vector<std::filesystem::path>& package_path,
+                               const std::vector<std::string>& locks) {
   LoadOptions options;
   options.package_path = package_path;
+  for (const std::string& text : locks) {
+    const auto eq = text.find('=');
+    const auto value = eq == std::string::npos ? std::nullopt : parse_number(text.substr(eq + 1));
+    if (eq == std::string::npos || eq == 0 || !value) {
+      throw UsageError("--lock: expected NAME=VALUE with VALUE a finite number [rad | m], got '" +
+                       text + "', e.g. --lock panda_finger_joint1=0.02");
+    }
+    const std::string name = text.substr(0, eq);
+    if (!options.locked_joints.emplace(name, *value).second)
+      throw UsageError("--lock: joint '" + name + "' is locked twice");
+    options.locked_joint_sources[name] = "--lock " + text;
+  }
+  return options;
+}
+
+RobotDescription load_robot_file(const std::filesystem::path& path, const LoadOptions& options) {
+  check_input_file(path, "robot", kMaxTextFileBytes);
   return load_robot(path, options);
 }
 

@@ -22,6 +22,7 @@ struct DynamicsOptions {
   std::string in;
   std::string out;
   std::vector<std::filesystem::path> package_path;
+  std::vector<std::string> lock;
 };
 
 /// Columns of the input for an n-joint robot: t, q1..qn, dq1..dqn, ddq1..ddqn.
@@ -45,7 +46,8 @@ void run_dynamics(const DynamicsOptions& opt) {
   std::optional<Pose> given_pose;
   if (opt.sensor_pose_given) given_pose = parse_pose(opt.sensor_pose, "--sensor-pose");
 
-  const RobotDescription robot = load_robot_file(opt.robot, opt.package_path);
+  const RobotDescription robot =
+      load_robot_file(opt.robot, robot_load_options(opt.package_path, opt.lock));
   const Model& model = robot.model;
   const int n = model.nq();
   std::string which = "--sensor-pose";
@@ -144,6 +146,7 @@ void register_dynamics(CLI::App& app) {
              "rpy). Default: the model's frame 'sensor', else the root link's origin, aligned")
           ->type_name("\"X Y Z R P Y\"");
   add_package_path_option(*sub, opt->package_path);
+  add_lock_option(*sub, opt->lock);
   sub->footer(
       "\nThe reading is what the robot discharges onto the sensor: force and moment about the "
       "sensor\n"

@@ -30,6 +30,7 @@ struct EstimateOptions {
   std::string figure_format = "png";
   bool ignore_extra_joints = false;
   std::vector<std::filesystem::path> package_path;
+  std::vector<std::string> lock;
 };
 
 std::pair<double, double> parse_interval(const std::string& text) {
@@ -50,8 +51,7 @@ void run_estimate(const EstimateOptions& opt) {
     description += ", excluding [" + e + "] s";
   }
   if (!(opt.plot_points >= 10)) throw UsageError("--plot-points must be at least 10");
-  LoadOptions load;
-  load.package_path = opt.package_path;
+  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   check_input_file(opt.log, "log");
 
@@ -127,6 +127,7 @@ void register_estimate(CLI::App& app) {
                 "Ignore log columns of joints beyond the robot's n (q8.. on a 7-joint robot); "
                 "without it they are an error");
   add_package_path_option(*sub, opt->package_path);
+  add_lock_option(*sub, opt->lock);
   sub->callback([opt]() { run_estimate(*opt); });
 }
 

@@ -14,6 +14,7 @@ namespace {
 struct InfoOptions {
   std::filesystem::path robot;
   std::vector<std::filesystem::path> package_path;
+  std::vector<std::string> lock;
 };
 
 std::string joint_type_name(JointType type) {
@@ -68,11 +69,13 @@ std::string limits_text(const Joint& j) {
   if (!std::isinf(j.effort_limit)) t += ", effort " + fmt(j.effort_limit) + eff;
   t += ", damping " + fmt(j.damping) + (revolute ? " N m s/rad" : " N s/m");
   t += ", friction " + fmt(j.friction) + eff;
+  if (j.armature != 0.0) t += ", armature " + fmt(j.armature) + (revolute ? " kg m^2" : " kg");
   return t;
 }
 
 void run_info(const InfoOptions& opt) {
-  const RobotDescription robot = load_robot_file(opt.robot, opt.package_path);
+  const RobotDescription robot =
+      load_robot_file(opt.robot, robot_load_options(opt.package_path, opt.lock));
   const Model& model = robot.model;
   std::ostringstream out;
 
@@ -141,6 +144,7 @@ void register_info(CLI::App& app) {
       ->required()
       ->type_name("FILE");
   add_package_path_option(*sub, opt->package_path);
+  add_lock_option(*sub, opt->lock);
   sub->footer("\nExample:\n  extwrench info models/paper_arm.urdf");
   sub->callback([opt] { run_info(*opt); });
 }

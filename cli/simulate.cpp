@@ -23,6 +23,7 @@ struct SimulateOptions {
   bool no_figures = false;
   std::string figure_format = "png";
   std::vector<std::filesystem::path> package_path;
+  std::vector<std::string> lock;
 };
 
 const NamedMetrics* window_named(const ReplayResult& r, const std::string& name) {
@@ -82,8 +83,7 @@ void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
 }
 
 void run_simulate(const SimulateOptions& opt) {
-  LoadOptions load;
-  load.package_path = opt.package_path;
+  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
   const Scenario scenario = load_scenario(opt.scenario, load);
   const Pose& X_WS = scenario.simulation.sensor.X_WS;
   const bool default_pose =
@@ -144,6 +144,7 @@ void register_simulate(CLI::App& app) {
   sub->add_flag("--no-figures", opt->no_figures, "Do not draw figures (no gnuplot needed)");
   add_figure_format_option(*sub, opt->figure_format);
   add_package_path_option(*sub, opt->package_path);
+  add_lock_option(*sub, opt->lock);
   sub->callback([opt]() { run_simulate(*opt); });
 }
 

@@ -32,7 +32,8 @@ void check_schemes(const Scenario& s, const std::filesystem::path& first_dir) {
     if (const auto at = text.find(kRobot); at != std::string::npos)
       text.replace(at, kRobot.size(), "robot: " + quoted + "\n");
     try {
-      (void)load_estimator_config_string(text, first_dir / scheme.name / "config.yaml");
+      (void)load_estimator_config_string(text, first_dir / scheme.name / "config.yaml",
+                                         s.robot_options);
     } catch (const Error& e) {
       throw Error(s.source.string() + ":" + std::to_string(scheme.line) + ": scheme '" +
                   scheme.name + "': " + e.what());

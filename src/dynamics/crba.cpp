@@ -29,6 +29,7 @@ const MatrixX& crba_no_kinematics(const Model& model, Data& data) {
     data.composite_first_moment[p] += h;
     data.composite_inertia_O[p] += I_O;
   }
+  detail::add_armature_diagonal(model, data.M);
   return data.M;
 }
 

@@ -182,6 +182,7 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
     }
   }
   if constexpr (full) data.root_wrench_W = data.bias_f[0];
+  detail::add_armature_times(model, dq, data.momentum);  // p = (B_links + I_a) q_dot
 }
 
 }  // namespace

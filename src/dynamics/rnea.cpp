@@ -116,7 +116,9 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
     X_parent.rotation = R;
     X_parent.translation = O;
   }
-  return backward_pass(model, data, external);
+  backward_pass(model, data, external);
+  detail::add_armature_times(model, ddq, data.tau);  // the rotors: not in the base wrench
+  return data.tau;
 }
 
 const VectorX& rnea_no_kinematics(const Model& model, Data& data,
@@ -144,7 +146,9 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
                                       data.a[i]) +
                 detail::cross_force(data.v[i], hi);
   }
-  return backward_pass(model, data, external);
+  backward_pass(model, data, external);
+  detail::add_armature_times(model, ddq, data.tau);
+  return data.tau;
 }
 
 Vector6 sensor_reading_world(const Data& data, const Vector3& p_WS) {

@@ -16,6 +16,27 @@ inline auto ang(Vector6& x) { return x.tail<3>(); }
 inline auto lin(const Vector6& x) { return x.head<3>(); }
 inline auto ang(const Vector6& x) { return x.tail<3>(); }
 
+/// Armature (docs/model.md "Armature"): B_ii += a_i. A zero armature adds nothing at all (not
+/// even +0.0), so a model without armature computes exactly what it did before.
+inline void add_armature_diagonal(const Model& model, MatrixX& M) {
+  const int nb = model.num_bodies();
+  for (int i = 1; i < nb; ++i) {
+    const double a = model.joints[static_cast<std::size_t>(i)].armature;
+    if (a != 0.0) M(i - 1, i - 1) += a;
+  }
+}
+
+/// out_i += a_i x_i for the joints with armature: tau += I_a q_ddot (RNEA), p += I_a q_dot
+/// (momentum).
+inline void add_armature_times(const Model& model, const Eigen::Ref<const VectorX>& x,
+                               VectorX& out) {
+  const int nb = model.num_bodies();
+  for (int i = 1; i < nb; ++i) {
+    const double a = model.joints[static_cast<std::size_t>(i)].armature;
+    if (a != 0.0) out[i - 1] += a * x[i - 1];
+  }
+}
+
 /// Motion cross product v x m (v = [v_O; w]): [w x m_v + v_O x m_w; w x m_w].
 inline Vector6 cross_motion(const Vector6& v, const Vector6& m) {
   Vector6 out;

@@ -55,7 +55,10 @@ bool finite_inertia(const Inertia& in) noexcept {
 void validate(const EstimatorOptions& o, const Model& model) {
   const std::string where = "estimator for robot '" + model.name + "'";
   if (!model.is_serial_chain()) {
-    throw Error(where + ": the model is not a serial chain; isolation by joint index needs one");
+    throw Error(where + ": the model is not a serial chain (isolation by joint index needs one); " +
+                describe_branches(model) +
+                ". Lock the joints of all branches but one: --lock NAME=VALUE on the command "
+                "line, or locked_joints: {NAME: VALUE} in the configuration or scenario");
   }
   validate_contact(o.contact, model, where);
   validate_sensor(o.sensor, where);

@@ -71,6 +71,7 @@ class DhParser {
     if (const YAML::Node frames = root["frames"]) parse_frames(frames, builder);
 
     RobotDescription r;
+    lock_joints(options, builder);
     r.model = builder.build();
     r.geometry = io_detail::build_geometry(r.model, shapes_, base_dir_, options);
     return r;
@@ -85,7 +86,7 @@ class DhParser {
   void parse_joint(const YAML::Node& j, const std::string& path, ModelBuilder& builder) {
     rd_.only_keys(j, path,
                   {"name", "type", "a", "alpha", "d", "theta", "lower", "upper", "velocity",
-                   "effort", "damping", "friction", "link"});
+                   "effort", "damping", "friction", "armature", "link"});
     JointSpec js;
     js.source = at(j);
     js.name = rd_.string(rd_.required(j, path, "name"), path + ".name");
@@ -103,6 +104,8 @@ class DhParser {
     js.effort_limit = number(j, "effort", path, kInf);
     js.damping = number(j, "damping", path, 0.0);
     js.friction = number(j, "friction", path, 0.0);
+    js.armature = number(j, "armature", path, 0.0);
+    if (js.armature < 0.0) rd_.fail(j["armature"], path + ".armature", "expected a number >= 0");
     const Pose P = place(js, a, alpha, d, theta);  // X_{body i, DH frame i}
     js.parent = parent_;
 

@@ -105,6 +105,16 @@ void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOp
   o.friction = jf;
 }
 
+// "model" (the robot file's), or one number per joint (or one for all) [kg m^2 | kg]: the
+// reflected rotor inertias replace the robot file's (docs/model.md "Armature").
+void read_armature(const YamlReader& rd, const YAML::Node& a, Model& model) {
+  if (a.IsScalar() && a.Scalar() == "model") return;
+  const Range range = io_detail::non_negative(">= 0 [kg m^2 | kg]");
+  const VectorX values = rd.vector(a, "armature", model.nq(), &range);
+  for (int i = 1; i < model.num_bodies(); ++i)
+    model.joints[static_cast<std::size_t>(i)].armature = values[i - 1];
+}
+
 void read_payload(const YamlReader& rd, const YAML::Node& p, const Model& model,
                   EstimatorOptions& o) {
   rd.only_keys(p, "payload", {"link", "mass", "com", "inertia"});
@@ -161,6 +171,9 @@ void read_robot(const YamlReader& rd, const YAML::Node& root, const fs::path& so
   const fs::path robot_rel = rd.string(root["robot"], "robot");
   cfg.robot_path = robot_rel.is_absolute() ? robot_rel : source.parent_path() / robot_rel;
   if (root["gravity"]) robot_options.gravity = rd.vector3(root["gravity"], "gravity");
+  if (root["locked_joints"])
+    rd.locked_joints(root["locked_joints"], "locked_joints", robot_options);
+  cfg.locked_joints = robot_options.locked_joints;
   try {
     cfg.robot = load_robot(cfg.robot_path, robot_options);
   } catch (const Error& e) {
@@ -174,11 +187,12 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   const YamlReader rd(source.string());
   if (!root.IsDefined() || root.IsNull()) rd.fail(root, "(top level)", "empty configuration");
   rd.only_keys(root, "",
-               {"robot", "gravity", "sensor", "contact", "observer", "detection", "acceleration",
-                "friction", "payload", "solver", "isolation"});
+               {"robot", "locked_joints", "gravity", "sensor", "contact", "observer", "detection",
+                "acceleration", "friction", "armature", "payload", "solver", "isolation"});
   EstimatorConfig cfg;
   cfg.source = source;
   read_robot(rd, root, source, robot_options, cfg);
+  if (root["armature"]) read_armature(rd, root["armature"], cfg.robot.model);
   const Model& model = cfg.robot.model;
   const int n = model.nq();
   EstimatorOptions& o = cfg.options;
@@ -272,6 +286,15 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   const std::filesystem::path rel = std::filesystem::relative(robot, directory, ec);
   if (!ec && !rel.empty()) robot = rel;
   y << "robot: " << robot.string() << '\n';
+  if (!config.locked_joints.empty()) {
+    y << "locked_joints: {";
+    const char* sep = "";
+    for (const auto& [name, value] : config.locked_joints) {
+      y << sep << name << ": " << value;
+      sep = ", ";
+    }
+    y << "}\n";
+  }
   y << "gravity: " << list3(model.gravity) << '\n';
   y << "sensor:\n  type: " << to_string(o.sensor.type) << '\n';
   y << "  pose: {xyz: " << list3(o.sensor.pose.translation)
@@ -294,6 +317,12 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
       << ", smoothing_velocity: " << o.friction->smoothing_velocity << "}\n";
   } else {
     y << "friction: model\n";
+  }
+  if (model.has_armature()) {
+    VectorX armature(model.nq());
+    for (int i = 1; i < model.num_bodies(); ++i)
+      armature[i - 1] = model.joints[static_cast<std::size_t>(i)].armature;
+    y << "armature: " << list(armature) << '\n';
   }
   if (o.payload) {
     const Inertia& in = o.payload->inertia;

@@ -22,6 +22,39 @@ bool exists_file(const fs::path& p) {
   return fs::is_regular_file(p, ec);
 }
 
+// The last `count` components of a relative path ("meshes/collision/link0.stl").
+std::string trailing_parts(const std::string& relative, int count) {
+  std::size_t at = relative.size();
+  for (int k = 0; k < count && at != std::string::npos && at > 0; ++k)
+    at = relative.rfind('/', at - 1);
+  return at == std::string::npos ? relative : relative.substr(at + 1);
+}
+
+constexpr std::size_t kMaxDirsShown = 8;
+
+// Each directory may hold packages (DIR/NAME/rel), be the package itself (DIR/rel, its name
+// NAME or not), or hold the files under a trailing part of rel: a model directory copied out
+// of its package keeps "meshes/collision/link0.stl" but not "robots/panda_description/". The
+// longest trailing part wins, and at least the file and its directory must match (a lone file
+// name could be any link's mesh).
+std::optional<fs::path> find_in_package_dirs(const std::vector<fs::path>& dirs,
+                                             const std::string& package,
+                                             const std::string& relative) {
+  for (const fs::path& dir : dirs) {
+    if (exists_file(dir / package / relative)) return dir / package / relative;
+    if (exists_file(dir / relative)) return dir / relative;
+  }
+  for (const fs::path& dir : dirs) {
+    for (std::size_t slash = relative.find('/'); slash != std::string::npos;
+         slash = relative.find('/', slash + 1)) {
+      const std::string tail = relative.substr(slash + 1);
+      if (tail.find('/') == std::string::npos) break;
+      if (exists_file(dir / tail)) return dir / tail;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::vector<std::string_view> split_ws(std::string_view text) {
@@ -62,18 +95,20 @@ std::optional<fs::path> resolve_mesh_path(const std::string& uri, const fs::path
         }
       }
     }
-    for (const fs::path& dir : dirs) {
-      // A search directory contains packages; it may also be the package itself (ROS allows both).
-      for (const fs::path& candidate :
-           {dir / package / relative, dir.filename() == package ? dir / relative : fs::path()}) {
-        if (!candidate.empty() && exists_file(candidate)) return candidate;
-      }
-    }
+    if (const auto found = find_in_package_dirs(dirs, package, relative)) return found;
     if (why) {
-      *why = "cannot resolve '" + uri + "': no file '" + relative + "' in a package '" + package +
-             "' under LoadOptions::package_path" +
-             (options.use_ros_package_path ? " or ROS_PACKAGE_PATH" : "") + " (" +
-             std::to_string(dirs.size()) + " directories searched)";
+      std::string searched;
+      for (std::size_t i = 0; i < dirs.size() && i < kMaxDirsShown; ++i)
+        searched += (i == 0 ? "'" : ", '") + dirs[i].string() + "'";
+      if (dirs.size() > kMaxDirsShown)
+        searched += " and " + std::to_string(dirs.size() - kMaxDirsShown) + " more";
+      *why = "cannot resolve '" + uri + "': no file '" + relative + "' of package '" + package +
+             "' (nor a trailing part of that path, such as '" + trailing_parts(relative, 2) +
+             "') in the directories searched: " + (dirs.empty() ? std::string("none") : searched) +
+             (options.use_ros_package_path ? " (--package-path DIR, then ROS_PACKAGE_PATH)"
+                                           : " (--package-path DIR)") +
+             "; give --package-path DIR with DIR the directory holding the package '" + package +
+             "', or the package's own directory";
     }
     return std::nullopt;
   }

@@ -27,8 +27,9 @@ struct ShapeSpec {
 };
 
 /// Resolves a mesh file name: `package://NAME/rest` through options.package_path then
-/// ROS_PACKAGE_PATH, `file:///abs`, or a path relative to `base_dir`. Returns nothing when the
-/// file cannot be found; `why` then says why.
+/// ROS_PACKAGE_PATH (each directory holding NAME/rest, or rest, or a trailing part of rest of
+/// at least two components; docs/model.md "Meshes"), `file:///abs`, or a path relative to
+/// `base_dir`. Returns nothing when the file cannot be found; `why` then says why.
 std::optional<std::filesystem::path> resolve_mesh_path(const std::string& uri,
                                                        const std::filesystem::path& base_dir,
                                                        const LoadOptions& options,

@@ -5,8 +5,18 @@
 #include <cctype>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/model/model_builder.hpp"
 
 namespace extwrench {
+
+void lock_joints(const LoadOptions& options, ModelBuilder& builder) {
+  for (const auto& [name, value] : options.locked_joints) {
+    const auto source = options.locked_joint_sources.find(name);
+    builder.lock_joint(
+        name, value,
+        source == options.locked_joint_sources.end() ? "locked_joints" : source->second);
+  }
+}
 
 RobotDescription load_robot(const std::filesystem::path& path, const LoadOptions& options) {
   std::string ext = path.extension().string();

@@ -155,7 +155,10 @@ void parse_robot(const YamlReader& y, const YAML::Node& root, const LoadOptions&
   std::error_code ec;
   if (!fs::is_regular_file(s.robot_path, ec))
     y.fail(root["robot"], "robot", "no such file '" + s.robot_path.string() + "'");
-  s.robot = load_robot(s.robot_path, robot_options);
+  LoadOptions options = robot_options;
+  if (root["locked_joints"]) y.locked_joints(root["locked_joints"], "locked_joints", options);
+  s.robot = load_robot(s.robot_path, options);
+  s.robot_options = options;
 }
 
 // seed: 3 or seeds: [1, 2, 3].
@@ -252,6 +255,10 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
       y.fail(kv.second["robot"], k + ".robot",
              "schemes use the scenario's perturbed model; remove 'robot'");
     }
+    if (kv.second["locked_joints"]) {
+      y.fail(kv.second["locked_joints"], k + ".locked_joints",
+             "schemes use the scenario's (reduced) model; give locked_joints at the top level");
+    }
     const YAML::Node sensor = kv.second["sensor"];
     if (sensor && !sensor.IsMap()) y.fail(sensor, k + ".sensor", "expected a mapping (type: ...)");
     if (!sensor || !sensor["type"]) {
@@ -272,8 +279,9 @@ Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& rob
   const YAML::Node root = io_detail::load_yaml_file(path, "scenario");
   if (!root.IsDefined() || root.IsNull()) throw Error(y.file() + ": the scenario is empty");
   y.only_keys(root, "",
-              {"robot", "seed", "seeds", "duration", "sample_time", "substeps", "model_error",
-               "trajectory", "controller", "forces", "sensors", "metrics", "figures", "schemes"});
+              {"robot", "locked_joints", "seed", "seeds", "duration", "sample_time", "substeps",
+               "model_error", "trajectory", "controller", "forces", "sensors", "metrics", "figures",
+               "schemes"});
   Scenario s;
   s.source = path;
   parse_robot(y, root, robot_options, s);

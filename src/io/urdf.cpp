@@ -77,6 +77,7 @@ class UrdfParser {
         builder.add_joint(parse_joint(e));
       }
     }
+    lock_joints(options, builder);
     RobotDescription robot_description;
     robot_description.model = builder.build();
     robot_description.geometry =
@@ -300,6 +301,13 @@ class UrdfParser {
     if (const XMLElement* dyn = e->FirstChildElement("dynamics")) {
       j.damping = number(dyn, "damping", owner, 0.0);
       j.friction = number(dyn, "friction", owner, 0.0);
+      // Our extension (docs/model.md "Armature"): the reflected rotor inertia, ignored by
+      // urdfdom; an attribute of <dynamics>, where the joint's other dynamic parameters are.
+      j.armature = number(dyn, "armature", owner, 0.0);
+      if (j.armature < 0.0)
+        fail(dyn, owner,
+             std::string("attribute 'armature': must not be negative, got '") +
+                 dyn->Attribute("armature") + "'");
     }
     return j;
   }

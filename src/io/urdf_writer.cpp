@@ -122,10 +122,12 @@ void add_joint(tinyxml2::XMLElement* robot, const Model& model, int b) {
   add_origin(joint, j.placement);
   joint->InsertNewChildElement("axis")->SetAttribute("xyz", vec(j.axis).c_str());
   add_limit(joint, j);
-  if (j.damping != 0.0 || j.friction != 0.0) {
+  if (j.damping != 0.0 || j.friction != 0.0 || j.armature != 0.0) {
     tinyxml2::XMLElement* dyn = joint->InsertNewChildElement("dynamics");
     dyn->SetAttribute("damping", num(j.damping).c_str());
     dyn->SetAttribute("friction", num(j.friction).c_str());
+    // Our extension (docs/model.md "Armature"); urdfdom and KDL read only the two above.
+    if (j.armature != 0.0) dyn->SetAttribute("armature", num(j.armature).c_str());
   }
 }
 

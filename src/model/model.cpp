@@ -1,6 +1,9 @@
 // Inertia arithmetic and Model look-ups.
 #include "extwrench/model/model.hpp"
 
+#include <string>
+#include <vector>
+
 #include "extwrench/core/error.hpp"
 
 namespace extwrench {
@@ -84,12 +87,61 @@ int Model::frame_index(std::string_view name) const {
   throw Error("model '" + this->name + "': no frame named '" + std::string(name) + "'");
 }
 
+bool Model::has_armature() const {
+  for (std::size_t i = 1; i < joints.size(); ++i) {
+    if (joints[i].armature != 0.0) return true;
+  }
+  return false;
+}
+
 bool Model::is_ancestor(int ancestor, int body) const {
   if (ancestor < 0 || body < 0 || body >= num_bodies()) return false;
   for (int b = body; b >= 0; b = parents[static_cast<std::size_t>(b)]) {
     if (b == ancestor) return true;
   }
   return false;
+}
+
+std::string describe_branches(const Model& model) {
+  const auto nb = static_cast<std::size_t>(model.num_bodies());
+  std::vector<std::vector<int>> children(nb);
+  std::vector<int> subtree(nb, 1);  // bodies under each, itself included
+  for (std::size_t i = 1; i < nb; ++i) {
+    const int p = model.parents[i];
+    if (p < 0 || static_cast<std::size_t>(p) >= i) return "(parents out of order)";
+    children[static_cast<std::size_t>(p)].push_back(static_cast<int>(i));
+  }
+  for (std::size_t i = nb; i-- > 1;)
+    subtree[static_cast<std::size_t>(model.parents[i])] += subtree[i];
+  // Each branch names its first kMax joints (depth first) and counts the rest; at most
+  // kMaxBranchings branching bodies are listed: the message stays short on any tree.
+  constexpr int kMax = 4;
+  constexpr int kMaxBranchings = 5;
+  const auto branch = [&](int first) {
+    std::string names;
+    int named = 0;
+    for (std::vector<int> stack{first}; !stack.empty() && named < kMax; ++named) {
+      const auto b = static_cast<std::size_t>(stack.back());
+      stack.pop_back();
+      names += (names.empty() ? "'" : ", '") + model.joints[b].name + "'";
+      stack.insert(stack.end(), children[b].rbegin(), children[b].rend());
+    }
+    const int rest = subtree[static_cast<std::size_t>(first)] - named;
+    if (rest > 0) names += " and " + std::to_string(rest) + " more";
+    return "branch " + names;
+  };
+  std::string out;
+  int branchings = 0;
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (children[i].size() < 2) continue;
+    if (++branchings > kMaxBranchings) continue;
+    out += (out.empty() ? "" : "; ") + std::string("body '") + model.bodies[i].name + "': ";
+    for (std::size_t c = 0; c < children[i].size(); ++c)
+      out += (c == 0 ? "" : ", ") + branch(children[i][c]);
+  }
+  if (branchings > kMaxBranchings)
+    out += "; and " + std::to_string(branchings - kMaxBranchings) + " more branching bodies";
+  return out;
 }
 
 }  // namespace extwrench

@@ -205,6 +205,9 @@ void validate_model(const Model& model) {
     if (!std::isfinite(j.damping) || !std::isfinite(j.friction)) {
       throw Error(jn + ": damping and friction must be finite");
     }
+    if (!std::isfinite(j.armature) || j.armature < 0.0) {
+      throw Error(jn + ": armature: expected a finite number >= 0, got " + num(j.armature));
+    }
   }
   for (const Frame& f : model.frames) {
     if (f.body < 0 || f.body >= static_cast<int>(nb))
@@ -249,6 +252,7 @@ Joint to_joint(const JointSpec& js, const Pose& X_body_parent_link) {
   j.effort_limit = js.effort_limit;
   j.damping = js.damping;
   j.friction = js.friction;
+  j.armature = js.armature;
   return j;
 }
 
@@ -322,6 +326,9 @@ void ModelBuilder::connect_joints(Topology& topology) const {
       throw Error(where + ": limit: effort must be non-negative, got " + num(j.effort_limit));
     if (!std::isfinite(j.damping)) throw Error(where + ": dynamics: damping must be finite");
     if (!std::isfinite(j.friction)) throw Error(where + ": dynamics: friction must be finite");
+    if (!std::isfinite(j.armature) || j.armature < 0.0)
+      throw Error(where + ": dynamics: armature must be a finite number >= 0, got " +
+                  num(j.armature));
   }
 }
 
@@ -455,6 +462,12 @@ void ModelBuilder::check_massless_bodies(const Model& model,
 }
 
 Model ModelBuilder::build() const {
+  if (!locks_.empty()) {
+    ModelBuilder reduced = *this;
+    reduced.apply_locks();
+    reduced.locks_.clear();
+    return reduced.build();
+  }
   const std::string model_where = "robot '" + name_ + "'";
   if (links_.empty()) throw Error(model_where + ": no links");
   if (links_.size() > kMaxLinks || joints_.size() > kMaxLinks) {

@@ -226,39 +226,7 @@ TEST(SensorModel, NoiseHasTheConfiguredBiasAndStandardDeviation) {
   }
 }
 
-TEST(PerturbModel, EveryEntryStaysWithinTheFractionAndZerosStayZero) {
-  Model model = random_chain({.n = 7, .seed = 30});
-  model.bodies[3].inertia.com.y() = 0.0;
-  model.bodies[5].inertia.inertia_com(0, 1) = model.bodies[5].inertia.inertia_com(1, 0) = 0.0;
-  const Model p = perturb_model(model, 0.01, 42);
-  int changed = 0;
-  for (int i = 0; i < model.num_bodies(); ++i) {
-    const Inertia& a = model.bodies[i].inertia;
-    const Inertia& b = p.bodies[i].inertia;
-    EXPECT_LE(std::abs(b.mass - a.mass), 0.01 * a.mass);
-    for (int k = 0; k < 3; ++k)
-      EXPECT_LE(std::abs(b.com[k] - a.com[k]), 0.01 * std::abs(a.com[k]) + 0.0);
-    EXPECT_LE((b.inertia_com - a.inertia_com).cwiseAbs().maxCoeff(),
-              0.01 * a.inertia_com.cwiseAbs().maxCoeff());
-    EXPECT_TRUE(b.inertia_com.isApprox(b.inertia_com.transpose(), 0.0));
-    changed += b.mass != a.mass;
-    EXPECT_TRUE(p.joints[i].placement.is_approx(model.joints[i].placement, 0.0));
-  }
-  EXPECT_EQ(changed, model.num_bodies());  // link 0 included
-  EXPECT_EQ(p.bodies[3].inertia.com.y(), 0.0);
-  EXPECT_EQ(p.bodies[5].inertia.inertia_com(0, 1), 0.0);
-  EXPECT_EQ(p.bodies[5].inertia.inertia_com(1, 0), 0.0);
-}
-
-TEST(PerturbModel, IsDeterministicPerSeed) {
-  const Model model = random_chain({.n = 4, .seed = 31});
-  const Model a = perturb_model(model, 0.01, 5);
-  const Model b = perturb_model(model, 0.01, 5);
-  const Model c = perturb_model(model, 0.01, 6);
-  EXPECT_EQ(a.bodies[2].inertia.mass, b.bodies[2].inertia.mass);
-  EXPECT_NE(a.bodies[2].inertia.mass, c.bodies[2].inertia.mass);
-  EXPECT_THROW((void)perturb_model(model, 0.7, 1), Error);
-}
+// sim::perturb_model: tests/sim/test_perturb.cpp.
 
 SinusoidalTrajectory small_sinusoid(int n) {
   SinusoidalTrajectory tr;

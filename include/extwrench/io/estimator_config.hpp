@@ -1,6 +1,7 @@
 // The estimator's configuration file (YAML; documented in docs/config.md):
 //
 //   robot: ../models/paper_arm.urdf   # URDF or DH YAML, relative to this file (required)
+//   locked_joints: {finger_1: 0.02}   # joints held fixed [rad | m] (a tree's branches)
 //   gravity: [0, 0, -9.81]            # [m/s^2], world frame; default: the robot file's
 //   sensor:
 //     type: ft                        # ft | force | none (required)
@@ -23,6 +24,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -36,7 +38,9 @@ struct EstimatorConfig {
   std::filesystem::path source;      ///< the configuration file (or the name given to the string)
   std::filesystem::path robot_path;  ///< resolved path of the robot file
   RobotDescription robot;            ///< loaded robot (gravity from the config applied)
-  EstimatorOptions options;          ///< link names resolved to body indices, sizes checked
+  /// Joints locked when loading it (the file's locked_joints and LoadOptions'), for to_yaml.
+  std::map<std::string, double> locked_joints;
+  EstimatorOptions options;  ///< link names resolved to body indices, sizes checked
   /// Where options.sensor.pose came from: "sensor.pose" when the file gives it, else the rule
   /// of default_sensor_pose() in words (printed at the start of a replay).
   std::string sensor_pose_source;

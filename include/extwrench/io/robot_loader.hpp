@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 
 namespace extwrench {
 
+class ModelBuilder;
+
 struct LoadOptions {
   /// Directories searched for `package://NAME/...`: NAME is looked up as a subdirectory of
   /// each. ROS_PACKAGE_PATH (colon-separated) is appended when `use_ros_package_path`.
@@ -19,7 +22,18 @@ struct LoadOptions {
   bool use_ros_package_path = true;
   bool load_meshes = true;         ///< false: mesh shapes are kept without triangles
   std::optional<Vector3> gravity;  ///< overrides the file's / default gravity
+  /// Joints held at a value [rad | m] (joint name -> value): each becomes fixed there and its
+  /// child link merges into the parent body (ModelBuilder::lock_joint), e.g. a gripper's
+  /// fingers, which make a tree of an arm. Unknown or fixed joints, values outside the limits
+  /// and non-finite values are errors.
+  std::map<std::string, double> locked_joints;
+  /// Where each lock was given, prefixing its errors ("--lock", "config.yaml:4:
+  /// locked_joints.NAME"); a joint missing here is named "locked_joints".
+  std::map<std::string, std::string> locked_joint_sources;
 };
+
+/// Hands `options.locked_joints` to `builder` (used by every loader).
+void lock_joints(const LoadOptions& options, ModelBuilder& builder);
 
 /// A robot: its dynamics model, its collision geometry, and where it came from.
 struct RobotDescription {

@@ -33,6 +33,9 @@ struct Scenario {
   std::filesystem::path source;
   std::filesystem::path robot_path;
   RobotDescription robot;
+  /// How `robot` was loaded (package path, locked joints with the scenario's own): what a
+  /// configuration naming the same robot file needs to load the same model.
+  LoadOptions robot_options;
   std::vector<std::uint64_t> seeds{1};
   double model_error = 0.01;  ///< ± fraction of every dynamic parameter (docs/simulation.md)
   sim::SimulationConfig simulation;  ///< forces, sensors, duration, steps (noise seed per run)

@@ -42,6 +42,11 @@ struct Joint {
   double effort_limit = std::numeric_limits<double>::infinity();
   double damping = 0.0;   ///< viscous friction [N m s/rad | N s/m] (URDF <dynamics>)
   double friction = 0.0;  ///< Coulomb friction [N m | N] (URDF <dynamics>)
+  /// Armature: the motor's rotor inertia reflected through the gears, r^2 I_rotor
+  /// [kg m^2 | kg] (URDF <dynamics armature>, docs/model.md "Armature"). It adds to B's
+  /// diagonal only (B_ii += armature, tau_i += armature q_ddot_i), as MuJoCo's joint armature and
+  /// KDL's joint inertia; the base reading does not see it (docs/model.md).
+  double armature = 0.0;
 };
 
 /// A body: one or more URDF links welded together by fixed joints.
@@ -76,6 +81,9 @@ struct Model {
   [[nodiscard]] int num_bodies() const { return static_cast<int>(bodies.size()); }
   /// True when parents[i] == i - 1 for every body: the estimators of Table I need this.
   [[nodiscard]] bool is_serial_chain() const;
+  /// True when some joint has a non-zero armature (the algorithms skip its O(n) terms otherwise,
+  /// so that a model without one computes bit for bit what it did before armature existed).
+  [[nodiscard]] bool has_armature() const;
   /// Total mass of all bodies, link 0 included [kg].
   [[nodiscard]] double total_mass() const;
 
@@ -90,5 +98,10 @@ struct Model {
   /// True when body `ancestor` is on the path from the root to `body` (a body is its own ancestor).
   [[nodiscard]] bool is_ancestor(int ancestor, int body) const;
 };
+
+/// Where the model branches, for the "not a serial chain" message: for each body with more than
+/// one child, the joints of each branch (e.g. "body 'hand': branch 'finger_1', branch
+/// 'finger_2'"); empty for a serial chain.
+[[nodiscard]] std::string describe_branches(const Model& model);
 
 }  // namespace extwrench

@@ -34,6 +34,7 @@ struct JointSpec {
   double effort_limit = std::numeric_limits<double>::infinity();
   double damping = 0.0;
   double friction = 0.0;
+  double armature = 0.0;  ///< reflected rotor inertia [kg m^2 | kg], Joint::armature
   std::string source;
 };
 
@@ -56,6 +57,12 @@ class ModelBuilder {
   void add_link(LinkSpec link) { links_.push_back(std::move(link)); }
   void add_joint(JointSpec joint) { joints_.push_back(std::move(joint)); }
   void add_frame(FrameSpec frame) { frames_.push_back(std::move(frame)); }
+  /// Locks the moving joint `name` at `value` [rad | m] (like Pinocchio's buildReducedModel):
+  /// build() turns it into a fixed joint whose origin includes that motion, so its child link
+  /// merges into the parent body, inertia composed, frames and collision shapes carried over.
+  /// build() throws, prefixed by `source` (e.g. "--lock" or "config.yaml:3: locked_joints"),
+  /// for an unknown or fixed joint, a non-finite value or one outside the joint's limits.
+  void lock_joint(std::string name, double value, std::string source);
 
   /// Validates everything (see validate_inertia and docs/model.md) and builds the Model:
   /// fixed joints merged into the parent body, bodies in topological (depth-first) order,
@@ -74,12 +81,20 @@ class ModelBuilder {
   static void check_massless_bodies(const Model& model,
                                     const std::vector<std::string>& body_source);
   [[nodiscard]] std::string cycle_message(const Topology& topology, int start) const;
+  void apply_locks();
+
+  struct Lock {
+    std::string joint;
+    double value = 0.0;
+    std::string source;
+  };
 
   std::string name_;
   Vector3 gravity_{0.0, 0.0, -9.81};
   std::vector<LinkSpec> links_;
   std::vector<JointSpec> joints_;
   std::vector<FrameSpec> frames_;
+  std::vector<Lock> locks_;
 };
 
 /// Throws extwrench::Error (prefixed by `where`) when mass properties are not physical:

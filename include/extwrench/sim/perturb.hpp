@@ -9,13 +9,14 @@
 
 namespace extwrench::sim {
 
-/// Returns a copy of `model` whose every body (link 0 included) has its mass, its CoM
-/// coordinates and its six inertia entries (about the CoM, body axes: xx, xy, xz, yy, yz, zz)
-/// each multiplied by (1 + u), u uniform in [-fraction, +fraction], drawn independently in that
-/// order, body by body, from sim::Rng(seed). Zero entries stay zero; the tensor stays symmetric.
-/// Kinematics, joint data and frames are unchanged. fraction = 0.01 is the paper's ±1 %.
-/// Throws extwrench::Error if fraction is not in [0, 0.5) (larger errors can make a body's
-/// inertia non-physical).
+/// Returns a copy of `model` with errors drawn from sim::Rng(seed), body by body (link 0
+/// included), in a parametrisation that stays physically valid (docs/simulation.md "The perturbed
+/// model"): the mass and each CoM coordinate multiplied by (1 + u); the rotational inertia
+/// about the CoM as its principal second moments J_k (>= 0 <=> PSD and triangle inequality),
+/// each multiplied by (1 + u), and its principal axes turned by an angle u [rad] about a random
+/// axis; u uniform in [-fraction, +fraction]. A non-zero joint armature is multiplied by (1 + u)
+/// too. Zero entries stay zero. Kinematics, other joint data and frames are unchanged.
+/// fraction = 0.01 is the paper's ±1 %. Throws extwrench::Error if fraction is not in [0, 0.5).
 [[nodiscard]] Model perturb_model(const Model& model, double fraction, std::uint64_t seed);
 
 }  // namespace extwrench::sim

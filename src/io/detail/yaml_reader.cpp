@@ -218,4 +218,16 @@ int YamlReader::body(const Model& model, const YAML::Node& node, const std::stri
   return *b;
 }
 
+void YamlReader::locked_joints(const YAML::Node& node, const std::string& key,
+                               LoadOptions& options) const {
+  if (!node.IsMap()) fail(node, key, "expected a mapping joint name -> value [rad | m]");
+  for (const auto& kv : node) {
+    const std::string name = kv.first.Scalar();
+    const std::string k = YamlReader::key(key, name);
+    const double value = number(kv.second, k);
+    if (options.locked_joints.emplace(name, value).second)
+      options.locked_joint_sources[name] = where(kv.second) + ": " + k;
+  }
+}
+
 }  // namespace extwrench::io_detail

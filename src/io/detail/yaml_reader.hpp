@@ -16,6 +16,7 @@
 #include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
 #include "extwrench/io/number_text.hpp"
+#include "extwrench/io/robot_loader.hpp"
 #include "extwrench/model/model.hpp"
 
 namespace extwrench::io_detail {
@@ -119,6 +120,9 @@ class YamlReader {
 
   /// ft | force | none.
   [[nodiscard]] SensorType sensor_type(const YAML::Node& node, const std::string& key) const;
+  /// `locked_joints: {NAME: VALUE, ...}` [rad | m] added to `options` (entries already there,
+  /// from the command line, win) with their file:line as the lock's source.
+  void locked_joints(const YAML::Node& node, const std::string& key, LoadOptions& options) const;
   /// The index of the body named by the scalar.
   [[nodiscard]] int body(const Model& model, const YAML::Node& node, const std::string& key) const;
 
