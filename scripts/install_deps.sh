@@ -11,6 +11,9 @@ packages=(
   # assimp's CMake targets link libz.so, which libassimp-dev does not pull in.
   zlib1g-dev
   gnuplot-nox
+  # The Python module (docs/python.md): pybind11 and the interpreter's headers to build it,
+  # numpy at run time, pytest for tests/python, matplotlib for examples/python.
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do
