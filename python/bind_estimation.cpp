@@ -80,8 +80,9 @@ std::unique_ptr<Estimator> make(const py::object& robot, const py::object& confi
   const Robot* r = robot.is_none() ? nullptr : robot.cast<const Robot*>();
   if (r != nullptr) load = r->options;
   if (py::isinstance<py::dict>(config)) {
-    py::dict d = py::reinterpret_borrow<py::dict>(config);
-    d = py::dict(d);  // a copy: the caller's dict is left as it was
+    // A copy: the caller's dict is left as it was.
+    auto d = py::reinterpret_steal<py::dict>(PyDict_Copy(config.ptr()));
+    if (!d) throw py::error_already_set();
     if (r != nullptr && d.contains("robot")) {
       throw py::value_error("config: robot: give the robot either as the argument or as the "
                             "config's 'robot' key, not both");

@@ -10,7 +10,7 @@ import pytest
 import extwrench
 
 SOURCE_DIR = pathlib.Path(os.environ.get("EXTWRENCH_SOURCE_DIR",
-                                         pathlib.Path(__file__).resolve().parents[2]))
+                                         pathlib.Path(__file__).resolve().parents[2])).resolve()
 PAPER_URDF = SOURCE_DIR / "models" / "paper_arm.urdf"
 PAPER_SCENARIO = SOURCE_DIR / "scenarios" / "paper.yaml"
 
@@ -61,3 +61,11 @@ def random_state(rng, n):
 def bits(a):
     """The IEEE bit patterns of a float64 array (NaN payloads compared too)."""
     return np.ascontiguousarray(a, dtype=np.float64).view(np.uint64)
+
+
+def same(a, b):
+    """Equal arrays, float ones bit for bit (NaN equal to the same NaN)."""
+    a, b = np.asarray(a), np.asarray(b)
+    if a.dtype.kind == "f" or b.dtype.kind == "f":
+        return a.shape == b.shape and np.array_equal(bits(a), bits(b))
+    return np.array_equal(a, b)

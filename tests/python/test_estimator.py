@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import extwrench
-from conftest import PAPER_URDF, bits
+from conftest import PAPER_URDF, bits, same
 
 CONFIG = {
     "sensor": {"type": "ft", "pose": {"xyz": [0, 0, -0.31], "rpy": [0, 0, 0]}},
@@ -54,7 +54,7 @@ def test_dict_and_file_configs_agree(robot, log, tmp_path):
     b = extwrench.estimate(str(path), *log)
     c = extwrench.estimate(dict(CONFIG, robot=str(PAPER_URDF)), *log)
     for key in a:
-        assert np.array_equal(a[key], b[key]) and np.array_equal(a[key], c[key]), key
+        assert same(a[key], b[key]) and same(a[key], c[key]), key
 
 
 def test_update_loop_equals_batch(robot, log):
@@ -79,7 +79,7 @@ def test_update_loop_equals_batch(robot, log):
     np.testing.assert_allclose(batch["force_W"][late], np.tile([20.0, 0, 0], (late.sum(), 1)),
                                atol=0.5)
     assert e.link_name == robot.bodies[6]
-    assert {"contact", "force", "line_of_action"} <= e.flags
+    assert {"contact", "force", "line"} <= e.flags
 
 
 def test_batch_columns_and_views(robot, log):
@@ -91,7 +91,7 @@ def test_batch_columns_and_views(robot, log):
         assert c in out and out[c].shape == (rows,), c
     assert out["contact"].dtype == bool and out["link"].dtype == np.int32
     assert out["force_W"].shape == (rows, 3) and out["residual"].shape == (rows, n)
-    assert np.array_equal(out["fy"], out["force_W"][:, 1])
+    assert same(out["fy"], out["force_W"][:, 1])
     # The first row resets the estimator: free, zero residual (as `extwrench estimate`).
     assert out["status"][0] == "free" and not out["residual"][0].any()
 
@@ -216,7 +216,8 @@ def test_bad_update_raises_and_leaves_the_state(robot, log, name):
     (lambda t, q, dq, tau, r: (np.r_[t[:10], t[9], t[11:]], q, dq, tau, r), ["t[10]", "increase"]),
     (lambda t, q, dq, tau, r: (t, np.where(np.arange(7) == 3, np.nan, q), dq, tau, r),
      ["q[0, 3]", "nan"]),
-    (lambda t, q, dq, tau, r: (t, q, dq, tau, np.where(r > 100, np.inf, r)), ["reading[", "inf"]),
+    (lambda t, q, dq, tau, r: (t, q, dq, tau, np.where(np.arange(6) == 4, np.inf, r)),
+     ["reading[0, 4]", "inf"]),
 ])
 def test_batch_bad_input(robot, log, args, words):
     est = extwrench.ContactEstimator(robot, CONFIG)

@@ -70,7 +70,7 @@ def test_package_path(tmp_path):
 
 def test_errors_carry_the_cpp_message(tmp_path):
     bad = tmp_path / "bad.urdf"
-    bad.write_text("<robot name='x'>\n<link name='a'>\n<inertial><mass value='abc'/></inertial>"
+    bad.write_text("<robot name='x'>\n<link name='a'>\n<inertial><mass value='abc'/><inertia ixx='1' ixy='0' ixz='0' iyy='1' iyz='0' izz='1'/></inertial>"
                    "</link>\n</robot>\n")
     with pytest.raises(extwrench.Error) as info:
         extwrench.load_robot(bad)
