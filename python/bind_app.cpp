@@ -42,8 +42,7 @@ py::list run_scenario_py(const std::filesystem::path& scenario_path,
 
 void bind_app(py::module_& m) {
   m.def("_run_scenario", &run_scenario_py, py::arg("scenario"), py::arg("out_dir"),
-        py::arg("figures") = false,
-        py::arg("package_path") = std::vector<std::filesystem::path>{});
+        py::arg("figures") = false, py::arg("package_path") = std::vector<std::filesystem::path>{});
 }
 
 }  // namespace extwrench::python

@@ -62,19 +62,28 @@ BatchInput read_batch(const Estimator& e, const py::handle& t, const py::handle&
 
 /// The output columns, allocated with the GIL held and written without it.
 struct BatchOutput {
-  py::array_t<double> t, force, moment, point, point_L, line_point, line_direction, surface,
-      cond, residual;
+  py::array_t<double> t, force, moment, point, point_L, line_point, line_direction, surface, cond,
+      residual;
   py::array_t<bool> contact;
   py::array_t<std::int32_t> link, status;
   py::array_t<std::uint32_t> flags;
   std::vector<std::string> status_names;
 
   BatchOutput(py::ssize_t rows, int n)
-      : t(rows), force({rows, py::ssize_t{3}}), moment({rows, py::ssize_t{3}}),
-        point({rows, py::ssize_t{3}}), point_L({rows, py::ssize_t{3}}),
-        line_point({rows, py::ssize_t{3}}), line_direction({rows, py::ssize_t{3}}),
-        surface(rows), cond(rows), residual({rows, static_cast<py::ssize_t>(n)}), contact(rows),
-        link(rows), status(rows), flags(rows) {}
+      : t(rows),
+        force({rows, py::ssize_t{3}}),
+        moment({rows, py::ssize_t{3}}),
+        point({rows, py::ssize_t{3}}),
+        point_L({rows, py::ssize_t{3}}),
+        line_point({rows, py::ssize_t{3}}),
+        line_direction({rows, py::ssize_t{3}}),
+        surface(rows),
+        cond(rows),
+        residual({rows, static_cast<py::ssize_t>(n)}),
+        contact(rows),
+        link(rows),
+        status(rows),
+        flags(rows) {}
 };
 
 struct RowWriter {
@@ -91,13 +100,23 @@ struct RowWriter {
   int cached_index = -1;
 
   explicit RowWriter(BatchOutput& o, int n_, int bodies_)
-      : t(o.t.mutable_data()), force(o.force.mutable_data()), moment(o.moment.mutable_data()),
-        point(o.point.mutable_data()), point_L(o.point_L.mutable_data()),
-        line_point(o.line_point.mutable_data()), line_direction(o.line_direction.mutable_data()),
-        surface(o.surface.mutable_data()), cond(o.cond.mutable_data()),
-        residual(o.residual.mutable_data()), contact(o.contact.mutable_data()),
-        link(o.link.mutable_data()), status(o.status.mutable_data()),
-        flags(o.flags.mutable_data()), n(n_), bodies(bodies_), status_names(&o.status_names) {}
+      : t(o.t.mutable_data()),
+        force(o.force.mutable_data()),
+        moment(o.moment.mutable_data()),
+        point(o.point.mutable_data()),
+        point_L(o.point_L.mutable_data()),
+        line_point(o.line_point.mutable_data()),
+        line_direction(o.line_direction.mutable_data()),
+        surface(o.surface.mutable_data()),
+        cond(o.cond.mutable_data()),
+        residual(o.residual.mutable_data()),
+        contact(o.contact.mutable_data()),
+        link(o.link.mutable_data()),
+        status(o.status.mutable_data()),
+        flags(o.flags.mutable_data()),
+        n(n_),
+        bodies(bodies_),
+        status_names(&o.status_names) {}
 
   int status_of(const ContactEstimate& e) {
     if (e.status.ok() && e.flags == cached_flags && cached_index >= 0) return cached_index;

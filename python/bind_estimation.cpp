@@ -11,8 +11,7 @@
 
 namespace extwrench::python {
 
-Estimator::Estimator(EstimatorConfig c)
-    : config(std::move(c)), estimator(make_estimator(config)) {
+Estimator::Estimator(EstimatorConfig c) : config(std::move(c)), estimator(make_estimator(config)) {
   auto names = std::make_shared<std::vector<std::string>>();
   for (const Body& b : config.robot.model.bodies) names->push_back(b.name);
   body_names = std::move(names);
@@ -84,8 +83,9 @@ std::unique_ptr<Estimator> make(const py::object& robot, const py::object& confi
     auto d = py::reinterpret_steal<py::dict>(PyDict_Copy(config.ptr()));
     if (!d) throw py::error_already_set();
     if (r != nullptr && d.contains("robot")) {
-      throw py::value_error("config: robot: give the robot either as the argument or as the "
-                            "config's 'robot' key, not both");
+      throw py::value_error(
+          "config: robot: give the robot either as the argument or as the "
+          "config's 'robot' key, not both");
     }
     if (r != nullptr) d["robot"] = std::filesystem::absolute(r->description.source).string();
     return std::make_unique<Estimator>(load_estimator_config_string(json_text(d), "config", load));
@@ -138,10 +138,12 @@ void bind_estimate(py::module_& m) {
   py::class_<Estimate>(m, "Estimate",
                        "One sample of the estimator, world frame W. Quantities not estimated are "
                        "NaN and their flag is absent.")
-      .def_property_readonly("t", [](const Estimate& e) { return e.value.t; }, "[s]")
+      .def_property_readonly(
+          "t", [](const Estimate& e) { return e.value.t; }, "[s]")
       .def_property_readonly("contact", [](const Estimate& e) { return e.value.contact; })
-      .def_property_readonly("link", [](const Estimate& e) { return e.value.link; },
-                             "Contact link (body index), -1 if none.")
+      .def_property_readonly(
+          "link", [](const Estimate& e) { return e.value.link; },
+          "Contact link (body index), -1 if none.")
       .def_property_readonly(
           "link_name",
           [](const Estimate& e) -> py::object {
@@ -150,31 +152,35 @@ void bind_estimate(py::module_& m) {
             return py::str((*e.body_names)[static_cast<std::size_t>(l)]);
           },
           "Name of the contact link, None if none.")
-      .def_property_readonly("force_W", [](const Estimate& e) { return e.value.force_W; },
-                             "(3,) F_ext [N].")
-      .def_property_readonly("moment_W", [](const Estimate& e) { return e.value.moment_W; },
-                             "(3,) pure moment M_ext [N m] (known point).")
-      .def_property_readonly("point_W", [](const Estimate& e) { return e.value.point_W; },
-                             "(3,) contact point [m].")
-      .def_property_readonly("point_L", [](const Estimate& e) { return e.value.point_L; },
-                             "(3,) contact point in the link's frame [m].")
-      .def_property_readonly("line_point_W",
-                             [](const Estimate& e) { return e.value.line_point_W; },
-                             "(3,) point of the line of action nearest O_l (eq. 20) [m].")
-      .def_property_readonly("line_direction_W",
-                             [](const Estimate& e) { return e.value.line_direction_W; },
-                             "(3,) unit direction of the line of action.")
-      .def_property_readonly("surface_distance",
-                             [](const Estimate& e) { return e.value.surface_distance; }, "[m]")
-      .def_property_readonly("residual",
-                             [](const Estimate& e) { return to_numpy(e.value.residual); },
-                             "(n,) tau_ext estimate used for isolation.")
+      .def_property_readonly(
+          "force_W", [](const Estimate& e) { return e.value.force_W; }, "(3,) F_ext [N].")
+      .def_property_readonly(
+          "moment_W", [](const Estimate& e) { return e.value.moment_W; },
+          "(3,) pure moment M_ext [N m] (known point).")
+      .def_property_readonly(
+          "point_W", [](const Estimate& e) { return e.value.point_W; }, "(3,) contact point [m].")
+      .def_property_readonly(
+          "point_L", [](const Estimate& e) { return e.value.point_L; },
+          "(3,) contact point in the link's frame [m].")
+      .def_property_readonly(
+          "line_point_W", [](const Estimate& e) { return e.value.line_point_W; },
+          "(3,) point of the line of action nearest O_l (eq. 20) [m].")
+      .def_property_readonly(
+          "line_direction_W", [](const Estimate& e) { return e.value.line_direction_W; },
+          "(3,) unit direction of the line of action.")
+      .def_property_readonly(
+          "surface_distance", [](const Estimate& e) { return e.value.surface_distance; }, "[m]")
+      .def_property_readonly(
+          "residual", [](const Estimate& e) { return to_numpy(e.value.residual); },
+          "(n,) tau_ext estimate used for isolation.")
       .def_property_readonly("condition_number",
                              [](const Estimate& e) { return e.value.condition_number; })
-      .def_property_readonly("status", [](const Estimate& e) { return status_text(e.value.status); },
-                             "'ok', or the numerical outcome ('singular:...').")
-      .def_property_readonly("flags", [](const Estimate& e) { return flag_names(e.value.flags); },
-                             "frozenset of flag names ('contact', 'force', ...).")
+      .def_property_readonly(
+          "status", [](const Estimate& e) { return status_text(e.value.status); },
+          "'ok', or the numerical outcome ('singular:...').")
+      .def_property_readonly(
+          "flags", [](const Estimate& e) { return flag_names(e.value.flags); },
+          "frozenset of flag names ('contact', 'force', ...).")
       .def_property_readonly("flag_bits", [](const Estimate& e) { return e.value.flags; })
       .def("__repr__", [](const Estimate& e) {
         return "<extwrench.Estimate t=" + std::to_string(e.value.t) +
@@ -200,8 +206,9 @@ Unknown keys and bad values raise extwrench.Error with the loader's message.)")
            R"(One sample: t [s] (increasing), q, dq, tau (n,), reading: the base sensor's
 [f; n] (6,) or f (3,) in the sensor frame, moment about its origin (None without a sensor).
 Returns an Estimate. Bad input raises ValueError naming it; the state is then unchanged.)")
-      .def("request_tare", [](Estimator& e, int samples) { e.estimator.request_tare(samples); },
-           py::arg("samples"))
+      .def(
+          "request_tare", [](Estimator& e, int samples) { e.estimator.request_tare(samples); },
+          py::arg("samples"))
       .def_property(
           "sensor_bias", [](const Estimator& e) { return Vector6(e.estimator.sensor_bias()); },
           [](Estimator& e, const py::handle& bias) {
@@ -212,16 +219,13 @@ Returns an Estimate. Bad input raises ValueError naming it; the state is then un
           "(6,) sensor bias [f; n] in the sensor frame.")
       .def_property_readonly("nq", &Estimator::nq)
       .def_property_readonly("bodies", [](const Estimator& e) { return *e.body_names; })
-      .def_property_readonly("sensor_type",
-                             [](const Estimator& e) {
-                               return std::string(to_string(e.config.options.sensor.type));
-                             })
+      .def_property_readonly(
+          "sensor_type",
+          [](const Estimator& e) { return std::string(to_string(e.config.options.sensor.type)); })
       .def_property_readonly("robot_path", [](const Estimator& e) { return e.config.robot_path; })
       .def(
           "config_yaml",
-          [](const Estimator& e) {
-            return to_yaml(e.config, std::filesystem::current_path());
-          },
+          [](const Estimator& e) { return to_yaml(e.config, std::filesystem::current_path()); },
           "The configuration as YAML text (docs/config.md).")
       .def_property_readonly("last", [](const Estimator& e) {
         return Estimate{e.estimator.result(), e.body_names};

@@ -112,9 +112,8 @@ Status parse_status(const std::string& text) {
       s.code = static_cast<StatusCode>(c);
   }
   const auto bracket = text.find('[', colon);
-  const std::string channel = text.substr(colon + 1, bracket == std::string::npos
-                                                         ? std::string::npos
-                                                         : bracket - colon - 1);
+  const std::string channel = text.substr(
+      colon + 1, bracket == std::string::npos ? std::string::npos : bracket - colon - 1);
   for (int c = 0; c <= static_cast<int>(Channel::kBaseWrench); ++c) {
     if (to_string(static_cast<Channel>(c)) == channel) s.channel = static_cast<Channel>(c);
   }
@@ -198,7 +197,8 @@ py::dict metrics_py(const py::dict& truth, const py::dict& estimates, double fro
   if (!estimates.contains("residual")) {
     throw py::key_error("estimates: missing key 'residual'");
   }
-  const auto n = static_cast<int>(real_array(estimates["residual"], "estimates['residual']", 2).cols);
+  const auto n =
+      static_cast<int>(real_array(estimates["residual"], "estimates['residual']", 2).cols);
   const EstimateRows rows(estimates, n);
   if (rows.rows != t.rows) throw py::value_error("estimates: not as many rows as the truth");
   sim::MetricsAccumulator acc(sim::MetricsWindow{from, to, exclude});

@@ -115,8 +115,9 @@ sensor / ground); body i (1 <= i <= nq) is moved by joint i, whose coordinate is
 World frame W = the robot's root frame.)");
   robot.def_property_readonly("name", [](const Robot& r) { return r.model().name; })
       .def_property_readonly("nq", &Robot::nq, "Number of joint coordinates n.")
-      .def_property_readonly("source", [](const Robot& r) { return r.description.source; },
-                             "The file the robot was loaded from.")
+      .def_property_readonly(
+          "source", [](const Robot& r) { return r.description.source; },
+          "The file the robot was loaded from.")
       .def_property_readonly(
           "bodies",
           [](const Robot& r) {
@@ -142,13 +143,15 @@ World frame W = the robot's root frame.)");
           },
           "Per joint: name, type, placement (4 x 4, X_parent,joint at q = 0), axis (joint "
           "frame), lower/upper [rad | m], velocity_limit, effort_limit, damping, friction.")
-      .def_property_readonly("parents", [](const Robot& r) { return r.model().parents; },
-                             "Parent body of each body (parents[0] = -1).")
+      .def_property_readonly(
+          "parents", [](const Robot& r) { return r.model().parents; },
+          "Parent body of each body (parents[0] = -1).")
       .def_property_readonly(
           "lower", [](const Robot& r) { return limits(r, &Joint::lower); },
           "(n,) lower position limits [rad | m] (-inf when none).")
-      .def_property_readonly("upper", [](const Robot& r) { return limits(r, &Joint::upper); },
-                             "(n,) upper position limits [rad | m] (inf when none).")
+      .def_property_readonly(
+          "upper", [](const Robot& r) { return limits(r, &Joint::upper); },
+          "(n,) upper position limits [rad | m] (inf when none).")
       .def_property_readonly("velocity_limit",
                              [](const Robot& r) { return limits(r, &Joint::velocity_limit); })
       .def_property_readonly("effort_limit",
@@ -161,8 +164,9 @@ World frame W = the robot's root frame.)");
             return m;
           },
           "(n + 1,) body masses [kg].")
-      .def_property_readonly("gravity", [](const Robot& r) { return Vector3(r.model().gravity); },
-                             "(3,) gravity acceleration in W [m/s^2].")
+      .def_property_readonly(
+          "gravity", [](const Robot& r) { return Vector3(r.model().gravity); },
+          "(3,) gravity acceleration in W [m/s^2].")
       .def_property_readonly(
           "frames",
           [](const Robot& r) {
@@ -184,8 +188,9 @@ World frame W = the robot's root frame.)");
           "default_sensor_pose",
           [](const Robot& r) { return pose_matrix(default_sensor_pose(r.model())); },
           "(4, 4) X_WS: the frame named 'sensor' on link 0, else the identity.")
-      .def("body_index", [](const Robot& r, const py::object& b) { return r.body(b, "body"); },
-           py::arg("body"), "Index of a body given by name (a body or frame name) or index.")
+      .def(
+          "body_index", [](const Robot& r, const py::object& b) { return r.body(b, "body"); },
+          py::arg("body"), "Index of a body given by name (a body or frame name) or index.")
       .def("__repr__", [](const Robot& r) {
         return "<extwrench.Robot '" + r.model().name + "', " + std::to_string(r.nq()) +
                " joints, from '" + r.description.source.string() + "'>";
