@@ -31,6 +31,18 @@ Vector6 read_reading(const py::handle& obj, SensorType type) {
                           (type == SensorType::kForce ? "force" : "ft") +
                           ") needs a base reading [f; n] in the sensor frame");
   }
+  if (py::array_t<double>::check_(obj)) {
+    // Fast path of update(): a float64 (6,) or (3,) array, read in place.
+    const auto arr = py::reinterpret_borrow<py::array>(obj);
+    const py::ssize_t size = arr.ndim() == 1 ? arr.shape(0) : 0;
+    if (size == 6 || (size == 3 && type != SensorType::kForceTorque)) {
+      const auto* p = static_cast<const char*>(arr.data());
+      for (py::ssize_t i = 0; i < size; ++i) {
+        reading[i] = *reinterpret_cast<const double*>(p + i * arr.strides(0));
+      }
+      if (reading.allFinite()) return reading;
+    }
+  }
   const RealArray a = real_array(obj, "reading", 1);
   if (!(a.rows == 6 || (a.rows == 3 && type != SensorType::kForceTorque))) {
     throw py::value_error("reading: expected shape (6,)" +

@@ -81,7 +81,9 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
     """
     est = _estimator_for(source, reading)
     out = _extwrench._estimate(est, t, q, dq, tau, reading)
-    names = np.asarray(out.pop("status_names"), dtype=str)
+    # An object array of the few distinct texts: 8 bytes a row, not a fixed-width string each.
+    names = np.empty(len(out["status_names"]), dtype=object)
+    names[:] = out.pop("status_names")
     out["status"] = names[out.pop("status_index")]
     for key, prefix in (("force_W", "f"), ("moment_W", "m"), ("point_W", "p"),
                         ("line_point_W", "l")):
