@@ -87,3 +87,22 @@ def test_version_and_import():
                          capture_output=True, text=True, check=True).stdout.strip()
     cmake = (SOURCE_DIR / "CMakeLists.txt").read_text()
     assert "project(extwrench VERSION %s " % out in cmake
+
+
+def test_stubs_cover_the_module():
+    import ast
+    import pathlib
+    from extwrench import _extwrench
+    package = pathlib.Path(extwrench.__file__).parent
+    tree = ast.parse((package / "_extwrench.pyi").read_text())
+    stubbed = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    stubbed |= {t.id for n in tree.body if isinstance(n, ast.AnnAssign) for t in [n.target]}
+    public = {n for n in dir(_extwrench) if not n.startswith("__")}
+    assert public - stubbed == set()
+    for cls in ("Robot", "Estimate", "ContactEstimator", "ExternalWrench"):
+        node = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == cls)
+        members = {m.name for m in node.body if isinstance(m, ast.FunctionDef)}
+        members |= {m.target.id for m in node.body if isinstance(m, ast.AnnAssign)}
+        actual = {m for m in dir(getattr(_extwrench, cls)) if not m.startswith("_")}
+        assert actual - members == set(), cls
+    assert (package / "py.typed").exists() and (package / "__init__.pyi").exists()
