@@ -104,6 +104,39 @@ std::shared_ptr<Robot> load(const std::filesystem::path& path,
   return std::make_shared<Robot>(std::move(d), std::move(o));
 }
 
+/// The second half of Robot's properties: frames, collision geometry, the sensor frame, lookups.
+void bind_frames_and_geometry(py::class_<Robot, std::shared_ptr<Robot>>& robot) {
+  robot
+      .def_property_readonly(
+          "frames",
+          [](const Robot& r) {
+            std::vector<std::string> names;
+            for (const Frame& f : r.model().frames) names.push_back(f.name);
+            return names;
+          },
+          "Names of every frame (every URDF link, merged ones included).")
+      .def_property_readonly(
+          "shapes",
+          [](const Robot& r) {
+            py::list out;
+            for (const auto& s : r.description.geometry.shapes) out.append(shape_dict(s));
+            return out;
+          },
+          "Collision shapes: type, link, body, placement (4 x 4, X_body,shape), radius, length, "
+          "size, scale; meshes: mesh_path, vertices (V, 3), triangles (T, 3).")
+      .def_property_readonly(
+          "default_sensor_pose",
+          [](const Robot& r) { return pose_matrix(default_sensor_pose(r.model())); },
+          "(4, 4) X_WS: the frame named 'sensor' on link 0, else the identity.")
+      .def(
+          "body_index", [](const Robot& r, const py::object& b) { return r.body(b, "body"); },
+          py::arg("body"), "Index of a body given by name (a body or frame name) or index.")
+      .def("__repr__", [](const Robot& r) {
+        return "<extwrench.Robot '" + r.model().name + "', " + std::to_string(r.nq()) +
+               " joints, from '" + r.description.source.string() + "'>";
+      });
+}
+
 }  // namespace
 
 void bind_model(py::module_& m) {
@@ -166,35 +199,8 @@ World frame W = the robot's root frame.)");
           "(n + 1,) body masses [kg].")
       .def_property_readonly(
           "gravity", [](const Robot& r) { return Vector3(r.model().gravity); },
-          "(3,) gravity acceleration in W [m/s^2].")
-      .def_property_readonly(
-          "frames",
-          [](const Robot& r) {
-            std::vector<std::string> names;
-            for (const Frame& f : r.model().frames) names.push_back(f.name);
-            return names;
-          },
-          "Names of every frame (every URDF link, merged ones included).")
-      .def_property_readonly(
-          "shapes",
-          [](const Robot& r) {
-            py::list out;
-            for (const auto& s : r.description.geometry.shapes) out.append(shape_dict(s));
-            return out;
-          },
-          "Collision shapes: type, link, body, placement (4 x 4, X_body,shape), radius, length, "
-          "size, scale; meshes: mesh_path, vertices (V, 3), triangles (T, 3).")
-      .def_property_readonly(
-          "default_sensor_pose",
-          [](const Robot& r) { return pose_matrix(default_sensor_pose(r.model())); },
-          "(4, 4) X_WS: the frame named 'sensor' on link 0, else the identity.")
-      .def(
-          "body_index", [](const Robot& r, const py::object& b) { return r.body(b, "body"); },
-          py::arg("body"), "Index of a body given by name (a body or frame name) or index.")
-      .def("__repr__", [](const Robot& r) {
-        return "<extwrench.Robot '" + r.model().name + "', " + std::to_string(r.nq()) +
-               " joints, from '" + r.description.source.string() + "'>";
-      });
+          "(3,) gravity acceleration in W [m/s^2].");
+  bind_frames_and_geometry(robot);
 
   m.def("load_robot", &load, py::arg("path"), py::kw_only(),
         py::arg("package_path") = std::vector<std::filesystem::path>{},
