@@ -14,6 +14,9 @@ packages=(
   # The fuzz harnesses (make fuzz, make test-sanitize): clang, and its libFuzzer and sanitizer
   # runtimes, which clang-14 only recommends.
   clang libclang-rt-14-dev
+  # The Python module (docs/python.md): pybind11 and the interpreter's headers to build it,
+  # numpy at run time, pytest for tests/python, matplotlib for examples/python.
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do

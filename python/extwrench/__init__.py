@@ -1,0 +1,119 @@
+"""extwrench: external forces and moments on a robot arm from joint torques and a base sensor.
+
+Python bindings of the C++ library (docs/python.md). Arrays are numpy float64, one row per
+sample; frames follow docs/conventions.md (``_W`` world = the robot's root frame, ``_S`` the
+base sensor's frame, ``_L`` the contact link's frame). C++ errors raise :class:`Error` (a
+``ValueError``) with the library's message (``file:line: key: what``).
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from typing import Any, Dict, List, Optional, Union
+
+import numpy as np
+
+from ._extwrench import (  # noqa: F401  (re-exported)
+    ContactEstimator,
+    Error,
+    Estimate,
+    ExternalWrench,
+    Robot,
+    __version__,
+    bias,
+    coriolis_matrix,
+    crba,
+    forward_dynamics,
+    forward_kinematics,
+    gravity,
+    jacobian,
+    load_robot,
+    metrics,
+    read_log,
+    rnea,
+    sensor_reading,
+    write_estimates,
+)
+from . import _extwrench
+
+# The C++ names (dynamics/rnea.hpp) beside the short ones.
+bias_torques = bias
+gravity_torques = gravity
+
+__all__ = [
+    "ContactEstimator", "Error", "Estimate", "ExternalWrench", "Robot", "__version__", "bias",
+    "bias_torques", "coriolis_matrix", "crba", "estimate", "forward_dynamics",
+    "forward_kinematics", "gravity", "gravity_torques", "jacobian", "load_robot", "metrics",
+    "read_log", "rnea", "sensor_reading", "simulate", "write_estimates",
+]
+
+_AXES = ("x", "y", "z")
+
+
+def _estimator_for(source: Any, reading: Any) -> ContactEstimator:
+    if isinstance(source, ContactEstimator):
+        return source
+    if isinstance(source, Robot):
+        # A robot alone: the sensor type follows the readings given (none, force or ft).
+        if reading is None:
+            sensor = "none"
+        else:
+            sensor = "force" if np.shape(reading)[-1] == 3 else "ft"
+        return ContactEstimator(source, {"sensor": {"type": sensor}})
+    return ContactEstimator(None, source)
+
+
+def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.PathLike],
+             t: Any, q: Any, dq: Any, tau: Any, reading: Any = None) -> Dict[str, np.ndarray]:
+    """Runs a whole log through a fresh estimator (the loop is C++, the GIL released).
+
+    source: a ContactEstimator (its configuration; the object itself is not changed), a
+    configuration dict (with 'robot') or file, or a Robot (sensor type from `reading`).
+    t: (N,) strictly increasing [s]; q, dq, tau: (N, n) (dq None: differentiated as the log
+    reader does); reading: (N, 6) [f; n] or (N, 3) f in the sensor frame, or None.
+    The first row resets the estimator and is reported free with a zero residual, as
+    `extwrench estimate` does. Returns the columns of estimates.csv (docs/log_format.md):
+    t, contact (bool), link (body index, -1 when no contact; names: source.bodies),
+    fx fy fz, mx my mz, px py pz, lx ly lz (views of force_W, moment_W, point_W,
+    line_point_W, each (N, 3), world frame), status (str), cond, r1..rn (views of residual
+    (N, n)); besides: flags (uint32 bits), point_L, line_direction_W (N, 3), surface_distance.
+    """
+    est = _estimator_for(source, reading)
+    out = _extwrench._estimate(est, t, q, dq, tau, reading)
+    # An object array of the few distinct texts: 8 bytes a row, not a fixed-width string each.
+    names = np.empty(len(out["status_names"]), dtype=object)
+    names[:] = out.pop("status_names")
+    out["status"] = names[out.pop("status_index")]
+    for key, prefix in (("force_W", "f"), ("moment_W", "m"), ("point_W", "p"),
+                        ("line_point_W", "l")):
+        for i, axis in enumerate(_AXES):
+            out[prefix + axis] = out[key][:, i]
+    for i in range(out["residual"].shape[1]):
+        out["r%d" % (i + 1)] = out["residual"][:, i]
+    return out
+
+
+def simulate(scenario: Union[str, os.PathLike], out_dir: Optional[Union[str, os.PathLike]] = None,
+             figures: bool = False, package_path: Optional[List[str]] = None) -> List[Dict[str, Any]]:
+    """Runs a simulation scenario (docs/simulation.md) as `extwrench simulate` does.
+
+    Files go to out_dir (a temporary directory, removed afterwards, when None). Returns one dict
+    per seed: seed, dir, samples, peak_condition, peak_time, log (read_log's arrays, truth
+    included) and estimates {scheme: estimate()'s arrays}, equal to each scheme's estimates.csv.
+    """
+    if out_dir is None:
+        with tempfile.TemporaryDirectory(prefix="extwrench_") as tmp:
+            return simulate(scenario, os.path.join(tmp, "run"), figures, package_path)
+    runs = _extwrench._run_scenario(scenario, out_dir, figures, package_path or [])
+    for run in runs:
+        run["estimates"] = {}
+        log_path = os.path.join(run["dir"], "log.csv")
+        for scheme in run["schemes"]:
+            est = ContactEstimator(None, os.path.join(run["dir"], scheme, "config.yaml"))
+            if "log" not in run:
+                run["log"] = read_log(log_path, est)
+            log = run["log"]
+            run["estimates"][scheme] = estimate(est, log["t"], log["q"], log["dq"], log["tau"],
+                                                log.get("reading"))
+    return runs

@@ -1,0 +1,37 @@
+import os
+from typing import Any, Dict, List, Optional, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from ._extwrench import (
+    ContactEstimator as ContactEstimator,
+    Error as Error,
+    Estimate as Estimate,
+    ExternalWrench as ExternalWrench,
+    Robot as Robot,
+    __version__ as __version__,
+    bias as bias,
+    coriolis_matrix as coriolis_matrix,
+    crba as crba,
+    forward_dynamics as forward_dynamics,
+    forward_kinematics as forward_kinematics,
+    gravity as gravity,
+    jacobian as jacobian,
+    load_robot as load_robot,
+    metrics as metrics,
+    read_log as read_log,
+    rnea as rnea,
+    sensor_reading as sensor_reading,
+    write_estimates as write_estimates,
+)
+
+bias_torques = bias
+gravity_torques = gravity
+
+def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.PathLike],
+             t: npt.ArrayLike, q: npt.ArrayLike, dq: Optional[npt.ArrayLike],
+             tau: npt.ArrayLike, reading: Optional[npt.ArrayLike] = ...) -> Dict[str, np.ndarray]: ...
+def simulate(scenario: Union[str, os.PathLike],
+             out_dir: Optional[Union[str, os.PathLike]] = ..., figures: bool = ...,
+             package_path: Optional[List[str]] = ...) -> List[Dict[str, Any]]: ...
