@@ -29,6 +29,7 @@ void register_info(CLI::App& app);
 void register_dynamics(CLI::App& app);
 void register_estimate(CLI::App& app);
 void register_simulate(CLI::App& app);
+void register_calibrate(CLI::App& app);
 
 // ---- helpers shared by subcommands (common.cpp) --------------------------------------------
 

@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
   extwrench::cli::register_dynamics(app);
   extwrench::cli::register_estimate(app);
   extwrench::cli::register_simulate(app);
+  extwrench::cli::register_calibrate(app);
 
   if (argc <= 1) {  // a newcomer typing just `extwrench` gets the help, not an error
     std::cout << app.help();

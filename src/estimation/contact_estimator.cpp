@@ -47,6 +47,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   nominal_inertia_.reserve(model_.bodies.size());
   for (const Body& b : model_.bodies) nominal_inertia_.push_back(b.inertia);
   if (options_.friction) observer_.set_friction(*options_.friction);
+  tare_.bias_S = options_.sensor.bias_S;  // a calibrated bias (zero by default)
   if (options_.payload) apply_payload(options_.payload->body, &options_.payload->inertia);
   const double slowest = options_.acceleration == AccelerationRoute::kResidual
                              ? 1.0 / observer_.gains().minCoeff()

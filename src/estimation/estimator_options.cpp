@@ -25,6 +25,7 @@ void validate_sensor(const SensorOptions& s, const std::string& where) {
     throw Error(where + ": sensor.pose: expected a finite rigid transform");
   }
   if (s.tare_samples < 0) throw Error(where + ": sensor.tare: expected a sample count >= 0");
+  if (!s.bias_S.allFinite()) throw Error(where + ": sensor.bias: expected finite values");
 }
 
 void validate_numerics(const EstimatorOptions& o, const std::string& where) {

@@ -4,8 +4,10 @@
 
 #include <sstream>
 
+#include "detail/friction_yaml.hpp"
 #include "detail/yaml_reader.hpp"
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/calibration_file.hpp"
 #include "extwrench/model/model_builder.hpp"
 
 namespace extwrench {
@@ -19,10 +21,11 @@ using io_detail::YamlReader;
 constexpr int kDefaultTareSamples = 100;
 
 void read_sensor(const YamlReader& rd, const YAML::Node& sensor, SensorOptions& o) {
-  rd.only_keys(sensor, "sensor", {"type", "pose", "tare"});
+  rd.only_keys(sensor, "sensor", {"type", "pose", "tare", "bias"});
   if (!sensor["type"]) rd.fail(sensor, "sensor.type", "missing (ft | force | none)");
   o.type = rd.sensor_type(sensor["type"], "sensor.type");
   if (sensor["pose"]) o.pose = rd.pose(sensor["pose"], "sensor.pose");
+  if (sensor["bias"]) o.bias_S = rd.vector(sensor["bias"], "sensor.bias", 6);
   if (const YAML::Node t = sensor["tare"]) {
     if (YamlReader::is_boolean(t)) {
       o.tare_samples = rd.boolean(t, "sensor.tare") ? kDefaultTareSamples : 0;
@@ -82,7 +85,8 @@ void read_acceleration(const YamlReader& rd, const YAML::Node& a, EstimatorOptio
   o.acceleration = r == 0 ? AccelerationRoute::kResidual : AccelerationRoute::kDifferentiation;
 }
 
-// "model" (the robot file's), "none", or a mapping {viscous, coulomb, smoothing_velocity}.
+// "model" (the robot file's), "none", or a mapping {sign, viscous, coulomb, offset,
+// smoothing_velocity, velocity_shift} (detail/friction_yaml.hpp).
 void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOptions& o) {
   if (f.IsScalar()) {
     const std::string s = f.Scalar();
@@ -95,14 +99,44 @@ void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOp
     }
     return;
   }
-  rd.only_keys(f, "friction", {"viscous", "coulomb", "smoothing_velocity"});
-  JointFriction jf = JointFriction::none(n);
-  const Range coefficient = io_detail::non_negative();
-  if (f["viscous"]) jf.viscous = rd.vector(f["viscous"], "friction.viscous", n, &coefficient);
-  if (f["coulomb"]) jf.coulomb = rd.vector(f["coulomb"], "friction.coulomb", n, &coefficient);
-  rd.set_number_in(f, "friction", "smoothing_velocity", {0, 1e9, true, "> 0"},
-                   jf.smoothing_velocity);
-  o.friction = jf;
+  o.friction = io_detail::read_friction_mapping(rd, f, n, "friction");
+}
+
+// `calibration: CALIB.yaml` (relative to the configuration): friction, thresholds and sensor
+// bias from `extwrench calibrate`. Keys the configuration sets itself (friction,
+// detection.tau_min, detection.f_min, sensor.tare) win over the calibration's.
+void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::path& source, int n,
+                      EstimatorOptions& o) {
+  const YAML::Node node = root["calibration"];
+  const fs::path rel = rd.string(node, "calibration");
+  const fs::path path = rel.is_absolute() ? rel : source.parent_path() / rel;
+  Calibration cal;
+  try {
+    cal = load_calibration(path, n);
+  } catch (const Error& e) {
+    rd.fail(node, "calibration", std::string("cannot load '") + path.string() + "': " + e.what());
+  }
+  const VectorX gains =
+      o.observer_gain.size() == 1 ? VectorX::Constant(n, o.observer_gain[0]) : o.observer_gain;
+  if (!gains.isApprox(cal.observer_gain, 1e-12)) {
+    rd.fail(node, "calibration",
+            "'" + path.string() + "' was made with observer.gain " +
+                io_detail::yaml_list(cal.observer_gain) + ", this configuration uses " +
+                io_detail::yaml_list(gains) + ": set the same gain or calibrate again");
+  }
+  if (cal.sensor_type != o.sensor.type) {
+    rd.fail(node, "calibration",
+            "'" + path.string() + "' was made for sensor type " +
+                std::string(to_string(cal.sensor_type)) + ", this configuration has " +
+                std::string(to_string(o.sensor.type)));
+  }
+  const YAML::Node det = root["detection"];
+  if (!root["friction"]) o.friction = cal.friction;
+  if (!(det && det["tau_min"])) o.detection.tau_min = cal.tau_threshold;
+  if (cal.sensor_type != SensorType::kNone) {
+    if (!(det && det["f_min"])) o.detection.f_min = cal.force_threshold;
+    if (o.sensor.tare_samples == 0) o.sensor.bias_S = cal.sensor_bias_S;
+  }
 }
 
 // "model" (the robot file's), or one number per joint (or one for all) [kg m^2 | kg]: the
@@ -186,9 +220,10 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
                           const LoadOptions& robot_options) {
   const YamlReader rd(source.string());
   if (!root.IsDefined() || root.IsNull()) rd.fail(root, "(top level)", "empty configuration");
-  rd.only_keys(root, "",
-               {"robot", "locked_joints", "gravity", "sensor", "contact", "observer", "detection",
-                "acceleration", "friction", "armature", "payload", "solver", "isolation"});
+  rd.only_keys(
+      root, "",
+      {"robot", "locked_joints", "gravity", "sensor", "contact", "observer", "detection",
+       "acceleration", "friction", "armature", "payload", "solver", "isolation", "calibration"});
   EstimatorConfig cfg;
   cfg.source = source;
   read_robot(rd, root, source, robot_options, cfg);
@@ -214,6 +249,7 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (root["payload"]) read_payload(rd, root["payload"], model, o);
   if (root["solver"]) read_solver(rd, root["solver"], o.solver);
   if (root["isolation"]) read_isolation(rd, root["isolation"], o.isolation);
+  if (root["calibration"]) read_calibration(rd, root, source, n, o);
 
   // The remaining checks need the whole picture (serial chain, sizes).
   try {
@@ -300,6 +336,7 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   y << "  pose: {xyz: " << list3(o.sensor.pose.translation)
     << ", rpy: " << list3(rpy_from_rotation(o.sensor.pose.rotation)) << "}\n";
   y << "  tare: " << o.sensor.tare_samples << '\n';
+  if (!o.sensor.bias_S.isZero(0.0)) y << "  bias: " << list(VectorX(o.sensor.bias_S)) << '\n';
   y << "contact:\n  model: " << to_string(o.contact.model) << '\n';
   if (o.contact.model == ContactModel::kKnownPoint) {
     y << "  link: " << model.bodies[static_cast<std::size_t>(o.contact.link)].name << '\n';
@@ -312,9 +349,7 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   y << "acceleration: {route: " << to_string(o.acceleration)
     << ", cutoff: " << o.differentiation_cutoff << "}\n";
   if (o.friction) {
-    y << "friction: {viscous: " << list(o.friction->viscous)
-      << ", coulomb: " << list(o.friction->coulomb)
-      << ", smoothing_velocity: " << o.friction->smoothing_velocity << "}\n";
+    y << "friction: " << io_detail::friction_mapping_yaml(*o.friction) << '\n';
   } else {
     y << "friction: model\n";
   }

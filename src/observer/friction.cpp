@@ -25,15 +25,54 @@ JointFriction JointFriction::from_model(const Model& model) {
 
 bool JointFriction::is_zero() const noexcept {
   return (viscous.size() == 0 || viscous.isZero(0.0)) &&
-         (coulomb.size() == 0 || coulomb.isZero(0.0));
+         (coulomb.size() == 0 || coulomb.isZero(0.0)) && (offset.size() == 0 || offset.isZero(0.0));
+}
+
+std::string_view to_string(SmoothSign s) noexcept {
+  switch (s) {
+    case SmoothSign::kTanh:
+      return "tanh";
+    case SmoothSign::kSigmoid:
+      return "sigmoid";
+    case SmoothSign::kSaturation:
+      break;
+  }
+  return "saturation";
+}
+
+double smooth_sign(SmoothSign sign, double dq, double smoothing, double shift) noexcept {
+  switch (sign) {
+    case SmoothSign::kTanh:
+      return std::tanh(dq / smoothing);
+    case SmoothSign::kSigmoid:
+      return std::tanh((dq + shift) / smoothing) - std::tanh(shift / smoothing);
+    case SmoothSign::kSaturation:
+      break;
+  }
+  return std::clamp(dq / smoothing, -1.0, 1.0);
+}
+
+double smooth_sign(const JointFriction& friction, Eigen::Index i, double dq) noexcept {
+  const double shift = friction.velocity_shift.size() > 0 ? friction.velocity_shift[i] : 0.0;
+  return smooth_sign(friction.sign, dq, friction.smoothing(i), shift);
 }
 
 void friction_torque(const JointFriction& friction, const Eigen::Ref<const VectorX>& dq,
                      Eigen::Ref<VectorX> out) noexcept {
-  const double inv_vs = 1.0 / friction.smoothing_velocity;
+  const bool plain = friction.sign == SmoothSign::kSaturation && friction.offset.size() == 0 &&
+                     friction.joint_smoothing.size() == 0;
+  if (plain) {  // the URDF model: kept as it was, bit for bit
+    const double inv_vs = 1.0 / friction.smoothing_velocity;
+    for (Eigen::Index i = 0; i < dq.size(); ++i) {
+      const double sat = std::clamp(dq[i] * inv_vs, -1.0, 1.0);
+      out[i] = friction.viscous[i] * dq[i] + friction.coulomb[i] * sat;
+    }
+    return;
+  }
   for (Eigen::Index i = 0; i < dq.size(); ++i) {
-    const double sat = std::clamp(dq[i] * inv_vs, -1.0, 1.0);
-    out[i] = friction.viscous[i] * dq[i] + friction.coulomb[i] * sat;
+    const double offset = friction.offset.size() > 0 ? friction.offset[i] : 0.0;
+    out[i] = friction.viscous[i] * dq[i] + friction.coulomb[i] * smooth_sign(friction, i, dq[i]) +
+             offset;
   }
 }
 
@@ -52,6 +91,22 @@ void validate_friction(const JointFriction& friction, int n, const std::string& 
   };
   check(friction.viscous, "viscous");
   check(friction.coulomb, "coulomb");
+  auto check_optional = [&](const VectorX& v, const char* name, bool positive) {
+    if (v.size() != 0 && v.size() != n) {
+      throw Error(where + ": friction." + name + ": expected 0 or " + std::to_string(n) +
+                  " values, got " + std::to_string(v.size()));
+    }
+    for (Eigen::Index i = 0; i < v.size(); ++i) {
+      if (!std::isfinite(v[i]) || (positive && !(v[i] > 0.0))) {
+        throw Error(where + ": friction." + name + "[" + std::to_string(i) +
+                    "]: expected a finite " + (positive ? "value > 0" : "value") + ", got " +
+                    std::to_string(v[i]));
+      }
+    }
+  };
+  check_optional(friction.offset, "offset", false);
+  check_optional(friction.joint_smoothing, "smoothing_velocity", true);
+  check_optional(friction.velocity_shift, "velocity_shift", false);
   if (!(friction.smoothing_velocity > 0.0) || !std::isfinite(friction.smoothing_velocity)) {
     throw Error(where + ": friction.smoothing_velocity: expected a finite value > 0");
   }

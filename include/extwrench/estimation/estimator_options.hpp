@@ -19,6 +19,8 @@ struct SensorOptions {
   Pose pose;  ///< X_WS: pose of the sensor frame in the robot's root frame
   int tare_samples =
       0;  ///< > 0: bias = mean(reading − predicted) over the first samples after reset
+  Vector6 bias_S = Vector6::Zero();  ///< bias [f; n] in S at the start (calibration); a tare
+                                     ///< replaces it
 };
 
 struct ContactOptions {

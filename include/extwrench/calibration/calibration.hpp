@@ -1,0 +1,92 @@
+// Calibration from a contact-free log (docs/calibration.md): per-joint friction (viscous +
+// Coulomb with a smooth sign, observer/friction.hpp) and a constant torque offset, the base
+// sensor's bias, the residual noise left over and detection thresholds for a stated false-alarm
+// rate.
+//
+// Formulation (no q̈ needed): the momentum residual (eq. 4) is linear in the friction torque
+// the observer subtracts. With the friction model τ_f(q̇) = Σ_k θ_k φ_k(q̇) and the observer run
+// once without friction (residual r⁰), the residual with friction θ is exactly
+//
+//   r(θ) = r⁰ + Σ_k θ_k z_k,    z_k = the observer's filter applied to φ_k(q̇(t))
+//
+// (same exact first-order discretisation and trapezoidal rule as the observer), so the θ that
+// makes the residual of a contact-free log smallest is a linear least-squares problem per joint,
+// solved with a small ridge term on column-scaled regressors. The Coulomb smoothing velocity
+// (and the sigmoid's shift) enters non-linearly: it is chosen per joint on a grid, or set.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "extwrench/core/sample.hpp"
+#include "extwrench/estimation/estimator_options.hpp"
+#include "extwrench/observer/friction.hpp"
+
+namespace extwrench {
+
+struct CalibrationOptions {
+  SmoothSign sign = SmoothSign::kTanh;  ///< tanh or sigmoid (saturation also accepted)
+  double smoothing_velocity = 0.0;      ///< > 0: v_s fixed [rad/s]; 0: chosen per joint
+  double false_alarms_per_hour = 1.0;   ///< target rate of the thresholds, all joints together
+  double threshold_margin = 1.1;        ///< thresholds ≥ margin × the largest fitted residual
+  double regularisation = 1e-9;         ///< ridge λ relative to the scaled normal matrix
+  double settle_time = -1.0;            ///< skipped after the start [s]; < 0: 5 / min K
+  double contact_sigma = 12.0;          ///< a contact: residual above this many robust σ ...
+  double contact_min_duration = 0.05;   ///< ... for at least this long [s]
+  double max_contact_fraction = 0.2;    ///< more suspected contact than this: refused
+};
+
+/// Fit quality of one joint, over the samples used.
+struct JointFitReport {
+  double rms_before = 0.0;          ///< residual RMS with the configured friction [N m]
+  double rms_after = 0.0;           ///< residual RMS after calibration [N m]
+  double max_before = 0.0;          ///< max |residual| with the configured friction
+  double max_after = 0.0;           ///< max |residual| after calibration
+  double variance_explained = 0.0;  ///< 1 − var(after) / var(before)
+  double noise_std = 0.0;           ///< standard deviation of the residual after calibration
+  double crossing_rate = 0.0;       ///< up-crossings of its mean per second (Rice's ν₀) [1/s]
+  double condition = 0.0;           ///< of the column-scaled regression
+  double threshold = 0.0;           ///< τ_min for the false-alarm rate [N m]
+  bool threshold_from_max = false;  ///< threshold set by margin × max_after (heavier tails)
+};
+
+/// A time window whose residual does not look like free motion.
+struct SuspectWindow {
+  double t_begin = 0.0, t_end = 0.0;  ///< [s]
+  int joint = 0;                      ///< 1-based joint with the largest excess
+  double peak = 0.0;                  ///< largest |residual| in the window [N m]
+};
+
+struct Calibration {
+  JointFriction friction;  ///< viscous, Coulomb, offset, v_s (and φ) per joint
+  VectorX tau_threshold;   ///< detection τ_min per joint (n) [N m]
+  VectorX observer_gain;   ///< K the residual and thresholds were computed with (n)
+  SensorType sensor_type = SensorType::kNone;
+  Vector6 sensor_bias_S = Vector6::Zero();  ///< [f; n] in S (moment zero for a force sensor)
+  Vector3 force_noise_W = Vector3::Zero();  ///< std of F̂_ext per world axis after the bias [N]
+  double force_threshold = 0.0;             ///< F_min after calibration [N] (0: no sensor)
+  double false_alarms_per_hour = 1.0;
+  std::vector<JointFitReport> joints;
+  int samples_used = 0;
+  double t_begin = 0.0, t_end = 0.0;  ///< time span of the samples given [s]
+  std::string source;                 ///< the log it came from (set by the caller)
+  std::vector<SuspectWindow> suspect_windows;
+  std::vector<std::string> warnings;
+};
+
+/// Calibrates from `samples` (contact-free free motion, q̇ filled, t increasing) with the model
+/// and the estimator options (observer gain, sensor type and pose, payload). Throws
+/// extwrench::Error on a non-finite sample (its index), fewer samples than parameters, a joint
+/// whose friction the motion does not excite (naming the parameter and the motion that would),
+/// or a log whose residual looks like contact over more than max_contact_fraction (naming the
+/// time windows); shorter suspect windows are excluded, listed and warned about.
+[[nodiscard]] Calibration calibrate(const Model& model, const EstimatorOptions& options,
+                                    const std::vector<Sample>& samples,
+                                    const CalibrationOptions& calibration_options = {});
+
+/// The options with the calibration applied: friction, detection.tau_min and (with a sensor)
+/// f_min and the sensor bias.
+[[nodiscard]] EstimatorOptions apply_calibration(EstimatorOptions options,
+                                                 const Calibration& calibration);
+
+}  // namespace extwrench

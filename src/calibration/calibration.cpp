@@ -1,0 +1,356 @@
+#include "extwrench/calibration/calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "extwrench/core/error.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/estimation/contact_estimator.hpp"
+#include "friction_fit.hpp"
+
+namespace extwrench {
+namespace {
+
+using calibration_detail::JointFrictionFit;
+using calibration_detail::JointSeries;
+
+// A residual transient is over after this many time constants 1/K (e^{-5} < 1 %).
+constexpr double kSettleTimeConstants = 5.0;
+constexpr int kParametersPerJoint = 3;  // D, F_c, o
+constexpr double kWindowGap = 0.02;     // [s] flagged samples closer than this form one window
+constexpr double kMadToSigma = 1.4826;  // σ of a Gaussian from its median absolute deviation
+
+void check_samples(const std::vector<Sample>& samples, int n) {
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const Sample& s = samples[k];
+    const std::string where = "sample " + std::to_string(k) + " (t = " + std::to_string(s.t) + ")";
+    if (!std::isfinite(s.t)) throw Error(where + ": t is not finite");
+    if (k > 0 && !(s.t > samples[k - 1].t)) throw Error(where + ": t does not increase");
+    auto check = [&](const VectorX& v, const char* name) {
+      if (v.size() != n) {
+        throw Error(where + ": " + name + ": expected " + std::to_string(n) + " values, got " +
+                    std::to_string(v.size()));
+      }
+      for (int i = 0; i < n; ++i)
+        if (!std::isfinite(v[i]))
+          throw Error(where + ": " + name + std::to_string(i + 1) + " is not finite");
+    };
+    check(s.q, "q");
+    check(s.dq, "dq");
+    check(s.tau, "tau");
+  }
+}
+
+// The observer over the log with `friction`: residual r_k per joint (N × n), and e^{−K Δt_k}.
+void run_observer(const Model& model, const VectorX& gains, const JointFriction& friction,
+                  const std::vector<Sample>& samples, std::vector<JointSeries>& series,
+                  bool residual_only) {
+  const int n = model.nq();
+  Data data(model);
+  MomentumObserver observer(model, gains);
+  observer.set_friction(friction);
+  const std::size_t N = samples.size();
+  series.assign(static_cast<std::size_t>(n), JointSeries{});
+  for (JointSeries& s : series) {
+    s.r0.assign(N, 0.0);
+    if (!residual_only) {
+      s.dq.assign(N, 0.0);
+      s.alpha.assign(N, 0.0);
+    }
+  }
+  const Sample& first = samples.front();
+  if (Status st = observer.reset(model, data, first.t, first.q, first.dq, first.tau); !st.ok())
+    throw Error("calibration: observer reset failed at the first sample");
+  for (std::size_t k = 0; k < N; ++k) {
+    const Sample& s = samples[k];
+    if (k > 0 && !observer.update(model, data, s.t, s.q, s.dq, s.tau).ok())
+      throw Error("calibration: sample " + std::to_string(k) + " rejected by the observer");
+    for (int i = 0; i < n; ++i) {
+      JointSeries& js = series[static_cast<std::size_t>(i)];
+      js.r0[k] = observer.residual()[i];
+      if (residual_only) continue;
+      js.dq[k] = s.dq[i];
+      js.alpha[k] = k > 0 ? std::exp(-observer.gains()[i] * (s.t - samples[k - 1].t)) : 0.0;
+    }
+  }
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Windows where some joint's residual exceeds `sigmas` robust standard deviations for at least
+// `min_duration`: the signature of a contact (or of a model far off) rather than of noise.
+std::vector<SuspectWindow> suspect_windows(const std::vector<JointFrictionFit>& fits,
+                                           const std::vector<Sample>& samples,
+                                           const std::vector<char>& use, double sigmas,
+                                           double min_duration) {
+  const std::size_t n = fits.size(), N = samples.size();
+  std::vector<double> centre(n), sigma(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<double> r;
+    for (std::size_t k = 0; k < N; ++k)
+      if (use[k]) r.push_back(fits[i].residual[k]);
+    centre[i] = median(r);
+    for (double& x : r) x = std::abs(x - centre[i]);
+    sigma[i] = std::max(kMadToSigma * median(r), 1e-6);
+  }
+  std::vector<SuspectWindow> out;
+  SuspectWindow w;
+  bool open = false;
+  double excess_best = 0.0;
+  auto close = [&] {
+    if (open && w.t_end - w.t_begin >= min_duration - 1e-9) out.push_back(w);
+    open = false;
+  };
+  for (std::size_t k = 0; k < N; ++k) {
+    if (!use[k]) continue;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double excess = std::abs(fits[i].residual[k] - centre[i]) / sigma[i];
+      if (excess <= sigmas) continue;
+      if (open && samples[k].t - w.t_end > kWindowGap) close();
+      if (!open) {
+        w = SuspectWindow{samples[k].t, samples[k].t, static_cast<int>(i) + 1, 0.0};
+        excess_best = 0.0;
+        open = true;
+      }
+      w.t_end = samples[k].t;
+      if (excess > excess_best) {
+        excess_best = excess;
+        w.joint = static_cast<int>(i) + 1;
+        w.peak = std::abs(fits[i].residual[k]);
+      }
+    }
+  }
+  close();
+  return out;
+}
+
+// Threshold of one joint for `rate` false alarms per second: Rice's formula for the rate at
+// which a Gaussian process of standard deviation σ and mean-crossing rate ν₀ leaves |r| < u,
+// 2 ν₀ e^{−u²/2σ²}, solved for u; never below margin × the largest residual seen, scaled from
+// the fit window's duration to the target rate as a Gaussian's extreme would be (real residuals
+// have heavier tails than the Gaussian fitted to their spread).
+void joint_threshold(const std::vector<double>& r, const std::vector<Sample>& samples,
+                     const std::vector<char>& use, double rate, double margin, JointFitReport& j) {
+  double sum = 0.0, sum2 = 0.0, peak = 0.0, duration = 0.0;
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    if (!use[k]) continue;
+    sum += r[k];
+    sum2 += r[k] * r[k];
+    peak = std::max(peak, std::abs(r[k]));
+    ++count;
+  }
+  const double mean = sum / static_cast<double>(count);
+  j.noise_std = std::sqrt(std::max(sum2 / static_cast<double>(count) - mean * mean, 0.0));
+  j.rms_after = std::sqrt(sum2 / static_cast<double>(count));
+  j.max_after = peak;
+  std::size_t crossings = 0;
+  for (std::size_t k = 1; k < r.size(); ++k) {
+    if (!use[k] || !use[k - 1]) continue;
+    duration += samples[k].t - samples[k - 1].t;
+    if ((r[k - 1] - mean < 0.0) != (r[k] - mean < 0.0)) ++crossings;
+  }
+  j.crossing_rate = duration > 0 ? 0.5 * static_cast<double>(crossings) / duration : 0.0;
+  const double ratio = 2.0 * j.crossing_rate / rate;
+  const double target_log = std::log(std::max(ratio, 2.0));
+  const double gaussian = j.noise_std * std::sqrt(2.0 * target_log);
+  // The largest residual seen is (for a Gaussian) the level crossed about once in the fit
+  // window, σ √(2 ln(2 ν₀ T)); scaled as a Gaussian's level grows to the target rate, it keeps
+  // the tails the data actually have.
+  const double fit_log = std::log(std::max(2.0 * j.crossing_rate * duration, 2.0));
+  const double extrapolated = margin * peak * std::sqrt(std::max(target_log / fit_log, 1.0));
+  j.threshold_from_max = extrapolated > gaussian;
+  j.threshold = std::max(std::max(gaussian, extrapolated), 1e-6);
+}
+
+// Bias of the base sensor: the mean of reading − predicted no-contact reading (sensor frame)
+// with the calibrated friction; then F̂_ext's spread per world axis and F_min.
+void sensor_calibration(const Model& model, const EstimatorOptions& options,
+                        const std::vector<Sample>& samples, const std::vector<char>& use,
+                        const CalibrationOptions& o, Calibration& cal) {
+  EstimatorOptions opt = apply_calibration(options, cal);
+  opt.sensor.tare_samples = 0;
+  opt.sensor.bias_S.setZero();
+  const Pose& X_WS = opt.sensor.pose;
+  ContactEstimator est(model, GeometryModel{}, opt);
+  Vector6 sum = Vector6::Zero();
+  std::size_t count = 0;
+  for (std::size_t pass = 0; pass < 2; ++pass) {
+    if (!est.reset(samples.front()).ok()) throw Error("calibration: estimator reset failed");
+    Vector3 s1 = Vector3::Zero(), s2 = Vector3::Zero();
+    double peak = 0.0, sum_norm = 0.0, last_norm = std::nan("");
+    std::vector<double> norms;
+    for (std::size_t k = 1; k < samples.size(); ++k) {
+      if (!est.update(samples[k]).ok() || !use[k]) continue;
+      if (pass == 0) {
+        const Vector6 predicted_W = sensor_reading_world(est.data(), X_WS.translation);
+        Vector6 predicted_S;
+        predicted_S.head<3>() = X_WS.rotation.transpose() * predicted_W.head<3>();
+        predicted_S.tail<3>() = X_WS.rotation.transpose() * predicted_W.tail<3>();
+        sum += samples[k].sensor - predicted_S;
+        ++count;
+      } else {
+        const Vector3& f = est.result().force_W;
+        s1 += f;
+        s2 += f.cwiseProduct(f);
+        peak = std::max(peak, f.norm());
+        norms.push_back(f.norm());
+        sum_norm += f.norm();
+      }
+    }
+    if (count == 0) throw Error("calibration: no usable base-sensor sample");
+    if (pass == 0) {
+      cal.sensor_bias_S = sum / static_cast<double>(count);
+      if (opt.sensor.type == SensorType::kForce) cal.sensor_bias_S.tail<3>().setZero();
+      est.set_sensor_bias(cal.sensor_bias_S);
+    } else {
+      const Vector3 mean = s1 / static_cast<double>(count);
+      cal.force_noise_W =
+          (s2 / static_cast<double>(count) - mean.cwiseProduct(mean)).cwiseMax(0.0).cwiseSqrt();
+      // The same extrapolation of the largest ‖F̂‖ as for the joints (joint_threshold).
+      const double mean_norm = sum_norm / static_cast<double>(norms.size());
+      std::size_t crossings = 0;
+      for (const double x : norms) {
+        if (std::isfinite(last_norm) && (last_norm < mean_norm) != (x < mean_norm)) ++crossings;
+        last_norm = x;
+      }
+      const double duration = samples.back().t - samples.front().t;
+      const double nu = 0.5 * static_cast<double>(crossings) / duration;
+      const double rate = o.false_alarms_per_hour / 3600.0;
+      const double target_log = std::log(std::max(2.0 * nu / rate, 2.0));
+      const double fit_log = std::log(std::max(2.0 * nu * duration, 2.0));
+      cal.force_threshold = std::max(
+          o.threshold_margin * peak * std::sqrt(std::max(target_log / fit_log, 1.0)), 1e-3);
+    }
+  }
+}
+
+// Marks the samples inside the windows (and one settle time after each) as unused.
+void exclude_windows(const std::vector<SuspectWindow>& windows, const std::vector<Sample>& samples,
+                     double settle, std::vector<char>& use) {
+  for (std::size_t k = 0; k < samples.size(); ++k)
+    for (const SuspectWindow& w : windows)
+      if (samples[k].t >= w.t_begin - kWindowGap && samples[k].t <= w.t_end + settle) use[k] = 0;
+}
+
+}  // namespace
+
+Calibration calibrate(const Model& model, const EstimatorOptions& options,
+                      const std::vector<Sample>& samples, const CalibrationOptions& o) {
+  const int n = model.nq();
+  validate(options, model);
+  check_samples(samples, n);
+  const VectorX gains = MomentumObserver::checked_gains(options.observer_gain, n);
+  const double settle =
+      o.settle_time >= 0 ? o.settle_time : kSettleTimeConstants / gains.minCoeff();
+  const int parameters = kParametersPerJoint * n + reading_size(options.sensor.type);
+  std::vector<char> use(samples.size(), 0);
+  for (std::size_t k = 0; k < samples.size(); ++k)
+    use[k] = samples[k].t - samples.front().t >= settle - 1e-9 ? 1 : 0;
+  const auto used = static_cast<int>(std::count(use.begin(), use.end(), 1));
+  if (used < parameters) {
+    throw Error("calibration: " + std::to_string(used) + " samples after the first " +
+                std::to_string(settle) + " s (the residual's settling) for " +
+                std::to_string(parameters) + " parameters: record a longer motion");
+  }
+  // The model the estimator will use: payload included.
+  Model m = model;
+  if (options.payload) {
+    auto& body = m.bodies[static_cast<std::size_t>(options.payload->body)];
+    body.inertia = body.inertia + options.payload->inertia;
+  }
+  std::vector<JointSeries> series, before;
+  run_observer(m, gains, JointFriction::none(n), samples, series, false);
+  run_observer(m, gains, options.friction ? *options.friction : JointFriction::from_model(model),
+               samples, before, true);
+
+  Calibration cal;
+  cal.observer_gain = gains;
+  cal.sensor_type = options.sensor.type;
+  cal.false_alarms_per_hour = o.false_alarms_per_hour;
+  cal.t_begin = samples.front().t;
+  cal.t_end = samples.back().t;
+  const double check_smoothing = o.smoothing_velocity > 0 ? o.smoothing_velocity : 0.01;
+  std::vector<JointFrictionFit> fits(static_cast<std::size_t>(n));
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int i = 0; i < n; ++i) {
+      const auto& s = series[static_cast<std::size_t>(i)];
+      calibration_detail::check_excitation(s, use, i + 1, check_smoothing);
+      fits[static_cast<std::size_t>(i)] = calibration_detail::fit_joint(s, use, o, i + 1);
+    }
+    if (pass == 1) break;
+    // Short strong contacts, and long ones that the fit has partly absorbed (half the level,
+    // ten times the duration).
+    cal.suspect_windows =
+        suspect_windows(fits, samples, use, o.contact_sigma, o.contact_min_duration);
+    for (const SuspectWindow& w :
+         suspect_windows(fits, samples, use, 0.5 * o.contact_sigma, 10.0 * o.contact_min_duration))
+      cal.suspect_windows.push_back(w);
+    if (cal.suspect_windows.empty()) break;
+    exclude_windows(cal.suspect_windows, samples, settle, use);
+    const auto left = static_cast<int>(std::count(use.begin(), use.end(), 1));
+    std::string list;
+    for (const SuspectWindow& w : cal.suspect_windows)
+      list += " [" + std::to_string(w.t_begin) + ", " + std::to_string(w.t_end) + "] s (joint " +
+              std::to_string(w.joint) + ", " + std::to_string(w.peak) + " N m)";
+    if (used - left > o.max_contact_fraction * used || left < parameters) {
+      throw Error(
+          "calibration: the log does not look contact-free: the residual is far above "
+          "its noise during" +
+          list + "; record free motion only");
+    }
+    cal.warnings.push_back(
+        "possible contact (residual far above its noise), excluded from the "
+        "fit:" +
+        list);
+  }
+  cal.samples_used = static_cast<int>(std::count(use.begin(), use.end(), 1));
+  cal.friction = JointFriction::none(n);
+  cal.friction.sign = o.sign;
+  cal.friction.offset = VectorX::Zero(n);
+  cal.friction.joint_smoothing = VectorX::Zero(n);
+  if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift = VectorX::Zero(n);
+  cal.tau_threshold = VectorX::Zero(n);
+  const double rate = o.false_alarms_per_hour / 3600.0 / n;
+  for (int i = 0; i < n; ++i) {
+    const JointFrictionFit& f = fits[static_cast<std::size_t>(i)];
+    cal.friction.viscous[i] = f.viscous;
+    cal.friction.coulomb[i] = f.coulomb;
+    cal.friction.offset[i] = f.offset;
+    cal.friction.joint_smoothing[i] = f.smoothing;
+    if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift[i] = f.shift;
+    for (const std::string& w : f.warnings) cal.warnings.push_back(w);
+    JointFitReport j;
+    j.condition = f.condition;
+    JointFitReport b;
+    joint_threshold(before[static_cast<std::size_t>(i)].r0, samples, use, rate, 1.0, b);
+    j.rms_before = b.rms_after;
+    j.max_before = b.max_after;
+    joint_threshold(f.residual, samples, use, rate, o.threshold_margin, j);
+    j.variance_explained =
+        b.noise_std > 0 ? 1.0 - (j.noise_std * j.noise_std) / (b.noise_std * b.noise_std) : 0.0;
+    cal.tau_threshold[i] = j.threshold;
+    cal.joints.push_back(j);
+  }
+  if (options.sensor.type != SensorType::kNone)
+    sensor_calibration(model, options, samples, use, o, cal);
+  return cal;
+}
+
+EstimatorOptions apply_calibration(EstimatorOptions options, const Calibration& calibration) {
+  options.friction = calibration.friction;
+  options.detection.tau_min = calibration.tau_threshold;
+  if (calibration.sensor_type != SensorType::kNone && calibration.force_threshold > 0) {
+    options.detection.f_min = calibration.force_threshold;
+    options.sensor.bias_S = calibration.sensor_bias_S;
+  }
+  return options;
+}
+
+}  // namespace extwrench

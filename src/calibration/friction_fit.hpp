@@ -1,0 +1,39 @@
+// Calibration internals: the per-joint friction least squares on the momentum residual
+// (calibration.hpp explains the formulation).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "extwrench/calibration/calibration.hpp"
+
+namespace extwrench::calibration_detail {
+
+/// One joint's series over the log: q̇_k, the residual r⁰_k without friction, and the filter
+/// coefficient α_k = e^{−K Δt_k} of the step ending at sample k (α_0 unused).
+struct JointSeries {
+  std::vector<double> dq, r0, alpha;
+};
+
+/// The fitted friction of one joint and its fit statistics.
+struct JointFrictionFit {
+  double viscous = 0.0, coulomb = 0.0, offset = 0.0, smoothing = 0.05, shift = 0.0;
+  double condition = 1.0;
+  std::vector<double> residual;  ///< r(θ) over the whole log
+  std::vector<std::string> warnings;
+};
+
+/// The observer's filter of a regressor: z_k = α_k z_{k−1} + (1 − α_k) ½ (φ_{k−1} + φ_k), z_0 = 0.
+void filter_regressor(const std::vector<double>& phi, const std::vector<double>& alpha,
+                      std::vector<double>& z);
+
+/// Throws extwrench::Error when joint `joint` (1-based) does not move enough, in both
+/// directions, to identify its viscous and Coulomb friction over the samples in `use`.
+void check_excitation(const JointSeries& s, const std::vector<char>& use, int joint,
+                      double smoothing);
+
+/// Fits D, F_c, o (and v_s, φ on a grid unless fixed) on the samples with use[k] != 0.
+[[nodiscard]] JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
+                                         const CalibrationOptions& options, int joint);
+
+}  // namespace extwrench::calibration_detail

@@ -1,0 +1,203 @@
+#include "extwrench/io/calibration_file.hpp"
+
+#include <sstream>
+
+#include "detail/friction_yaml.hpp"
+#include "detail/yaml_reader.hpp"
+#include "extwrench/core/error.hpp"
+
+namespace extwrench {
+namespace io_detail {
+
+JointFriction read_friction_mapping(const YamlReader& rd, const YAML::Node& f, int n,
+                                    const std::string& key) {
+  rd.only_keys(f, key,
+               {"sign", "viscous", "coulomb", "offset", "smoothing_velocity", "velocity_shift"});
+  JointFriction jf = JointFriction::none(n);
+  const Range coefficient = non_negative();
+  const Range speed = positive();
+  if (f["sign"]) {
+    jf.sign = static_cast<SmoothSign>(
+        rd.one_of(f["sign"], key + ".sign", {"saturation", "tanh", "sigmoid"}));
+  }
+  if (f["viscous"]) jf.viscous = rd.vector(f["viscous"], key + ".viscous", n, &coefficient);
+  if (f["coulomb"]) jf.coulomb = rd.vector(f["coulomb"], key + ".coulomb", n, &coefficient);
+  if (f["offset"]) jf.offset = rd.vector(f["offset"], key + ".offset", n);
+  if (const YAML::Node v = f["smoothing_velocity"]) {
+    if (v.IsSequence()) {
+      jf.joint_smoothing = rd.vector(v, key + ".smoothing_velocity", n, &speed);
+    } else {
+      jf.smoothing_velocity = rd.number_in(v, key + ".smoothing_velocity", {0, 1e9, true, "> 0"});
+    }
+  }
+  if (f["velocity_shift"]) {
+    if (jf.sign != SmoothSign::kSigmoid)
+      rd.fail(f["velocity_shift"], key + ".velocity_shift", "only used with sign: sigmoid");
+    jf.velocity_shift = rd.vector(f["velocity_shift"], key + ".velocity_shift", n);
+  }
+  return jf;
+}
+
+std::string yaml_list(const VectorX& v) {
+  std::ostringstream o;
+  o.precision(17);
+  if (v.size() >= 1 && (v.array() == v[0]).all()) {
+    o << v[0];
+    return o.str();
+  }
+  o << '[';
+  for (Eigen::Index i = 0; i < v.size(); ++i) o << (i ? ", " : "") << v[i];
+  o << ']';
+  return o.str();
+}
+
+std::string friction_mapping_yaml(const JointFriction& f) {
+  std::ostringstream y;
+  y.precision(17);
+  y << '{';
+  if (f.sign != SmoothSign::kSaturation) y << "sign: " << to_string(f.sign) << ", ";
+  y << "viscous: " << yaml_list(f.viscous) << ", coulomb: " << yaml_list(f.coulomb);
+  if (f.offset.size() > 0) y << ", offset: " << yaml_list(f.offset);
+  if (f.joint_smoothing.size() > 0) {
+    // Always a list: a single number would be read back as the shared smoothing velocity.
+    y << ", smoothing_velocity: [";
+    for (Eigen::Index i = 0; i < f.joint_smoothing.size(); ++i)
+      y << (i ? ", " : "") << f.joint_smoothing[i];
+    y << ']';
+  } else {
+    y << ", smoothing_velocity: " << f.smoothing_velocity;
+  }
+  if (f.velocity_shift.size() > 0) y << ", velocity_shift: " << yaml_list(f.velocity_shift);
+  y << '}';
+  return y.str();
+}
+
+}  // namespace io_detail
+
+namespace {
+
+using io_detail::yaml_list;
+
+std::string joint_table(const Calibration& c) {
+  std::ostringstream y;
+  y.precision(6);
+  for (std::size_t i = 0; i < c.joints.size(); ++i) {
+    const JointFitReport& j = c.joints[i];
+    y << "    - {joint: " << i + 1 << ", rms_before: " << j.rms_before
+      << ", rms_after: " << j.rms_after << ", max_before: " << j.max_before
+      << ", max_after: " << j.max_after << ", variance_explained: " << j.variance_explained
+      << ", noise_std: " << j.noise_std << ", crossing_rate: " << j.crossing_rate
+      << ", condition: " << j.condition << ", threshold: " << j.threshold
+      << ", threshold_rule: " << (j.threshold_from_max ? "largest_residual" : "gaussian") << "}\n";
+  }
+  return y.str();
+}
+
+std::string holdout_yaml(const HoldoutReport& h) {
+  std::ostringstream y;
+  y.precision(6);
+  const double share = h.samples > 0 ? 100.0 * h.false_alarms / h.samples : 0.0;
+  y << "holdout:\n  samples: " << h.samples << "\n  duration: " << h.duration
+    << "\n  false_alarm_samples: " << h.false_alarms << "\n  false_alarm_percent: " << share
+    << "\n  raw_alarm_samples: " << h.raw_alarms
+    << "\n  uncalibrated_false_alarm_samples: " << h.uncalibrated_false_alarms
+    << "\n  calibrated_threshold: " << yaml_list(h.calibrated_threshold)
+    << "\n  best_constant_threshold_uncalibrated: " << yaml_list(h.best_constant_threshold)
+    << "\n  calibrated_max_residual: " << yaml_list(h.calibrated_max_residual)
+    << "\n  lever: " << h.lever << "\n  min_force_calibrated: [";
+  for (std::size_t l = 1; l < h.min_force_calibrated.size(); ++l)
+    y << (l > 1 ? ", " : "") << h.min_force_calibrated[l];
+  y << "]\n  min_force_best_constant: [";
+  for (std::size_t l = 1; l < h.min_force_constant.size(); ++l)
+    y << (l > 1 ? ", " : "") << h.min_force_constant[l];
+  y << "]\n  min_force_calibrated_best_constant: [";
+  for (std::size_t l = 1; l < h.min_force_calibrated_quiet.size(); ++l)
+    y << (l > 1 ? ", " : "") << h.min_force_calibrated_quiet[l];
+  y << "]\n";
+  return y.str();
+}
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (const char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out + '"';
+}
+
+}  // namespace
+
+std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdout) {
+  std::ostringstream y;
+  y.precision(17);
+  y << "# extwrench calibration (docs/calibration.md). Include it from an estimator\n"
+    << "# configuration with `calibration: THIS_FILE`.\n";
+  y << "calibration: {version: 1, source: " << quoted(c.source) << ", t_begin: " << c.t_begin
+    << ", t_end: " << c.t_end << ", false_alarms_per_hour: " << c.false_alarms_per_hour << "}\n";
+  y << "observer: {gain: " << yaml_list(c.observer_gain) << "}\n";
+  y << "friction: " << io_detail::friction_mapping_yaml(c.friction) << "\n";
+  y << "detection: {tau_min: " << yaml_list(c.tau_threshold);
+  if (c.sensor_type != SensorType::kNone) y << ", f_min: " << c.force_threshold;
+  y << "}\n";
+  y << "sensor: {type: " << to_string(c.sensor_type);
+  if (c.sensor_type != SensorType::kNone) {
+    y << ", bias: [";
+    for (int i = 0; i < 6; ++i) y << (i ? ", " : "") << c.sensor_bias_S[i];
+    y << "], force_noise_W: [" << c.force_noise_W.x() << ", " << c.force_noise_W.y() << ", "
+      << c.force_noise_W.z() << ']';
+  }
+  y << "}\n";
+  double worst = 0.0;
+  for (const JointFitReport& j : c.joints) worst = std::max(worst, j.condition);
+  y << "fit:\n  samples: " << c.samples_used << "\n  condition: " << worst << "\n  joints:\n"
+    << joint_table(c);
+  y << "  suspect_windows: [";
+  for (std::size_t i = 0; i < c.suspect_windows.size(); ++i) {
+    const SuspectWindow& w = c.suspect_windows[i];
+    y << (i ? ", " : "") << "{t_begin: " << w.t_begin << ", t_end: " << w.t_end
+      << ", joint: " << w.joint << ", peak: " << w.peak << '}';
+  }
+  y << "]\n";
+  if (holdout != nullptr) y << holdout_yaml(*holdout);
+  y << "warnings: [";
+  for (std::size_t i = 0; i < c.warnings.size(); ++i) y << (i ? ", " : "") << quoted(c.warnings[i]);
+  y << "]\n";
+  return y.str();
+}
+
+Calibration load_calibration(const std::filesystem::path& path, int n) {
+  return io_detail::at_loader_boundary(path.string(), [&] {
+    const YAML::Node root = io_detail::load_yaml_file(path, "calibration");
+    const io_detail::YamlReader rd(path.string());
+    if (!root.IsDefined() || !root.IsMap()) rd.fail(root, "(top level)", "empty calibration");
+    rd.only_keys(root, "",
+                 {"calibration", "observer", "friction", "detection", "sensor", "fit", "holdout",
+                  "warnings"});
+    Calibration c;
+    c.source = path.string();
+    const io_detail::Range positive = io_detail::positive();
+    const YAML::Node ob = rd.required(root, "", "observer");
+    rd.only_keys(ob, "observer", {"gain"});
+    c.observer_gain = rd.vector(rd.required(ob, "observer", "gain"), "observer.gain", n, &positive);
+    c.friction =
+        io_detail::read_friction_mapping(rd, rd.required(root, "", "friction"), n, "friction");
+    const YAML::Node det = rd.required(root, "", "detection");
+    rd.only_keys(det, "detection", {"tau_min", "f_min"});
+    c.tau_threshold =
+        rd.vector(rd.required(det, "detection", "tau_min"), "detection.tau_min", n, &positive);
+    const YAML::Node sensor = rd.required(root, "", "sensor");
+    rd.only_keys(sensor, "sensor", {"type", "bias", "force_noise_W"});
+    c.sensor_type = rd.sensor_type(rd.required(sensor, "sensor", "type"), "sensor.type");
+    if (c.sensor_type != SensorType::kNone) {
+      const VectorX bias = rd.vector(rd.required(sensor, "sensor", "bias"), "sensor.bias", 6);
+      c.sensor_bias_S = bias;
+      rd.set_number_in(det, "detection", "f_min", {0, 1e12, true, "> 0 [N]"}, c.force_threshold);
+      if (!(c.force_threshold > 0))
+        rd.fail(det, "detection.f_min", "missing (required with a sensor)");
+    }
+    return c;
+  });
+}
+
+}  // namespace extwrench
