@@ -3,6 +3,9 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <map>
+#include <string>
+
 #include "arrays.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
 #include "robot.hpp"
@@ -93,10 +96,11 @@ py::dict shape_dict(const CollisionShape& s) {
 
 std::shared_ptr<Robot> load(const std::filesystem::path& path,
                             const std::vector<std::filesystem::path>& package_path,
-                            bool use_ros_package_path, bool load_meshes,
-                            const py::object& gravity) {
+                            bool use_ros_package_path, bool load_meshes, const py::object& gravity,
+                            const std::map<std::string, double>& locked_joints) {
   LoadOptions o;
   o.package_path = package_path;
+  o.locked_joints = locked_joints;
   o.use_ros_package_path = use_ros_package_path;
   o.load_meshes = load_meshes;
   if (!gravity.is_none()) o.gravity = read_vector3(gravity, "gravity");
@@ -205,11 +209,13 @@ World frame W = the robot's root frame.)");
   m.def("load_robot", &load, py::arg("path"), py::kw_only(),
         py::arg("package_path") = std::vector<std::filesystem::path>{},
         py::arg("use_ros_package_path") = true, py::arg("load_meshes") = true,
-        py::arg("gravity") = py::none(),
+        py::arg("gravity") = py::none(), py::arg("locked_joints") = std::map<std::string, double>{},
         R"(Loads a URDF (.urdf, .xml) or a DH table (.yaml, .yml), chosen by extension.
 
 package_path: directories searched for package://NAME/... (NAME is a subdirectory of each);
 ROS_PACKAGE_PATH is appended when use_ros_package_path. gravity: (3,) in W, overrides the file's.
+locked_joints: {joint name: value [rad | m]}: those joints become fixed at those values and their
+bodies are merged (the reduced serial model of a tree, e.g. a gripper's fingers; docs/model.md).
 Raises extwrench.Error with the loader's message (file:line: field: what).)");
 }
 

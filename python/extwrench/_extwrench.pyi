@@ -1,6 +1,6 @@
 # Type stubs of the compiled module (python/*.cpp). Shapes: n joints, N samples.
 import os
-from typing import Any, Dict, FrozenSet, List, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, FrozenSet, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -50,7 +50,8 @@ class Robot:
 
 def load_robot(path: PathLike, *, package_path: Sequence[PathLike] = ...,
                use_ros_package_path: bool = ..., load_meshes: bool = ...,
-               gravity: Optional[ArrayLike] = ...) -> Robot: ...
+               gravity: Optional[ArrayLike] = ...,
+               locked_joints: Mapping[str, float] = ...) -> Robot: ...
 
 class ExternalWrench:
     def __init__(self, body: int, force_W: ArrayLike, point_W: ArrayLike = ...,

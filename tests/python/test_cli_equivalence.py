@@ -52,6 +52,10 @@ def test_estimate_is_bit_identical_to_the_cli(paper_run, cli_estimates, scheme, 
         elif name == "link":
             names = [est.bodies[i] if i >= 0 else "" for i in got["link"]]
             assert names == list(cells)
+        elif name == "link_candidates":
+            # Not yet in the batch output (issue 9 added the column after the bindings were
+            # written): the scenario's schemes use the paper's rule, which leaves it empty.
+            assert set(cells) == {""}
         elif name == "contact":
             assert [str(int(c)) for c in got["contact"]] == list(cells)
         else:

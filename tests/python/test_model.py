@@ -106,3 +106,26 @@ def test_stubs_cover_the_module():
         actual = {m for m in dir(getattr(_extwrench, cls)) if not m.startswith("_")}
         assert actual - members == set(), cls
     assert (package / "py.typed").exists() and (package / "__init__.pyi").exists()
+
+
+def test_locked_joints_equal_the_urdf_with_those_joints_fixed(tmp_path):
+    # The reference is the same file with the last joint made fixed by a text edit (locked at 0,
+    # its origin is the fixed joint's): the two must give the same reduced robot and torques.
+    text = PAPER_URDF.read_text()
+    joints, _ = urdf_joints()
+    name = joints[-1].get("name")
+    start = text.index(f'<joint name="{name}"')
+    head = text[start:text.index(">", start) + 1]
+    fixed = tmp_path / "fixed.urdf"
+    fixed.write_text(text.replace(head, head.replace('type="revolute"', 'type="fixed"')))
+    locked = extwrench.load_robot(PAPER_URDF, locked_joints={name: 0.0})
+    reference = extwrench.load_robot(fixed)
+    assert locked.nq == reference.nq == 6
+    assert name not in locked.joint_names
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q, dq, ddq = (rng.uniform(-1, 1, 6) for _ in range(3))
+        np.testing.assert_allclose(extwrench.rnea(locked, q, dq, ddq),
+                                   extwrench.rnea(reference, q, dq, ddq), rtol=0, atol=1e-12)
+    with pytest.raises(extwrench.Error, match="nope"):
+        extwrench.load_robot(PAPER_URDF, locked_joints={"nope": 0.0})
