@@ -14,6 +14,12 @@
 namespace extwrench {
 namespace {
 
+// What the rank forbids may appear only as the observable part of a rank-deficient case, flagged
+// `partial` (docs/estimator.md "Partial observability"), never as a full estimate.
+bool reported_in_full(const ContactEstimate& e, std::uint32_t flag) {
+  return e.has(flag) && !e.has(EstimateFlag::kPartial);
+}
+
 using test::SeededRng;
 
 constexpr int kConfigurationsPerLink = 100;
@@ -82,6 +88,9 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
     opt.detection.f_min = 1e-9;
     opt.detection.min_duration = 0.0;
     opt.solver.max_condition = kMaxCondition;
+    // The paper's rule: this test is about Table I, and its points are not all on the link's
+    // surface (geometry isolation has its own test: test_geometry_isolation).
+    opt.isolation.rule = IsolationRule::kResidual;
     ContactEstimator est(model, robot.geometry, opt);
     const CollisionShape& shape = robot.geometry.shapes[robot.geometry.body_shapes[link][0]];
 
@@ -123,9 +132,11 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
           ASSERT_TRUE(e.has(EstimateFlag::kForce)) << "link " << link;
           EXPECT_LE((e.force_W - F).norm(), kRelativeTol * F.norm()) << "link " << link;
         } else {
-          EXPECT_FALSE(e.has(EstimateFlag::kForce));
+          EXPECT_FALSE(reported_in_full(e, EstimateFlag::kForce));
           EXPECT_TRUE(e.has(EstimateFlag::kUnobservable));
-          EXPECT_TRUE(e.force_W.array().isNaN().all());
+          if (!e.has(EstimateFlag::kPartial)) {
+            EXPECT_TRUE(e.force_W.array().isNaN().all());
+          }
         }
         if (moment_or_point_expected(c.sensor, link)) {
           ASSERT_TRUE(e.has(EstimateFlag::kMoment)) << "link " << link;
@@ -133,9 +144,11 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
               << "link " << link;
           EXPECT_FALSE(e.has(EstimateFlag::kUnobservable));
         } else {
-          EXPECT_FALSE(e.has(EstimateFlag::kMoment)) << "link " << link;
+          EXPECT_FALSE(reported_in_full(e, EstimateFlag::kMoment)) << "link " << link;
           EXPECT_TRUE(e.has(EstimateFlag::kUnobservable)) << "link " << link;
-          EXPECT_TRUE(e.moment_W.array().isNaN().all());
+          if (!e.has(EstimateFlag::kPartial)) {
+            EXPECT_TRUE(e.moment_W.array().isNaN().all());
+          }
         }
         continue;
       }
@@ -155,7 +168,7 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
         EXPECT_LE((e.force_W - F).norm(), kRelativeTol * F.norm()) << "link " << link;
       } else {
         EXPECT_TRUE(e.has(EstimateFlag::kUnobservable)) << "link " << link;
-        EXPECT_FALSE(e.has(EstimateFlag::kForce));
+        EXPECT_FALSE(reported_in_full(e, EstimateFlag::kForce)) << "link " << link;
       }
       if (moment_or_point_expected(c.sensor, link)) {
         ASSERT_TRUE(e.has(EstimateFlag::kLineOfAction)) << "link " << link;
@@ -171,10 +184,12 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
         EXPECT_LE((e.point_L - p_L).norm(), kPointTol) << "link " << link;
         EXPECT_EQ(e.surface_distance, 0.0);
       } else {
-        EXPECT_FALSE(e.has(EstimateFlag::kLineOfAction)) << "link " << link;
+        EXPECT_FALSE(reported_in_full(e, EstimateFlag::kLineOfAction)) << "link " << link;
         EXPECT_TRUE(e.has(EstimateFlag::kUnobservable)) << "link " << link;
-        EXPECT_TRUE(e.line_point_W.array().isNaN().all());
-        EXPECT_TRUE(e.point_W.array().isNaN().all());
+        if (!e.has(EstimateFlag::kPartial)) {
+          EXPECT_TRUE(e.line_point_W.array().isNaN().all());
+          EXPECT_TRUE(e.point_W.array().isNaN().all());
+        }
       }
     }
     EXPECT_EQ(accepted, kConfigurationsPerLink)
@@ -225,7 +240,7 @@ TEST(TableOneObservability, ForceSensorMomentOnLinkThreeDependsOnTheRankNotTheIn
     EXPECT_TRUE(e.has(EstimateFlag::kForce));
     if (q2 == 0.0) {
       EXPECT_TRUE(e.has(EstimateFlag::kUnobservable));
-      EXPECT_FALSE(e.has(EstimateFlag::kMoment));
+      EXPECT_FALSE(reported_in_full(e, EstimateFlag::kMoment));
     } else {
       EXPECT_FALSE(e.has(EstimateFlag::kUnobservable));
       EXPECT_LE((e.moment_W - Vector3(0.5, 0.2, -0.3)).norm(), 1e-6);
