@@ -4,9 +4,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "extwrench/core/sample.hpp"
 #include "extwrench/sim/controller.hpp"
 #include "extwrench/sim/force_profile.hpp"
-#include "extwrench/core/sample.hpp"
 #include "extwrench/sim/sensor_model.hpp"
 
 namespace extwrench::sim {
