@@ -260,19 +260,6 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   return cfg;
 }
 
-std::string list(const VectorX& v) {
-  std::ostringstream o;
-  o.precision(17);
-  if (v.size() >= 1 && (v.array() == v[0]).all()) {
-    o << v[0];
-    return o.str();
-  }
-  o << '[';
-  for (Eigen::Index i = 0; i < v.size(); ++i) o << (i ? ", " : "") << v[i];
-  o << ']';
-  return o.str();
-}
-
 std::string list3(const Vector3& v) {
   std::ostringstream o;
   o.precision(17);
@@ -336,15 +323,16 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   y << "  pose: {xyz: " << list3(o.sensor.pose.translation)
     << ", rpy: " << list3(rpy_from_rotation(o.sensor.pose.rotation)) << "}\n";
   y << "  tare: " << o.sensor.tare_samples << '\n';
-  if (!o.sensor.bias_S.isZero(0.0)) y << "  bias: " << list(VectorX(o.sensor.bias_S)) << '\n';
+  if (!o.sensor.bias_S.isZero(0.0))
+    y << "  bias: " << io_detail::yaml_list(VectorX(o.sensor.bias_S)) << '\n';
   y << "contact:\n  model: " << to_string(o.contact.model) << '\n';
   if (o.contact.model == ContactModel::kKnownPoint) {
     y << "  link: " << model.bodies[static_cast<std::size_t>(o.contact.link)].name << '\n';
     y << "  point: " << list3(o.contact.point) << '\n';
   }
-  y << "observer:\n  gain: " << list(o.observer_gain) << '\n';
-  y << "detection:\n  tau_min: " << list(o.detection.tau_min) << "\n  f_min: " << o.detection.f_min
-    << "\n  release_ratio: " << o.detection.release_ratio
+  y << "observer:\n  gain: " << io_detail::yaml_list(o.observer_gain) << '\n';
+  y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min)
+    << "\n  f_min: " << o.detection.f_min << "\n  release_ratio: " << o.detection.release_ratio
     << "\n  min_duration: " << o.detection.min_duration << '\n';
   y << "acceleration: {route: " << to_string(o.acceleration)
     << ", cutoff: " << o.differentiation_cutoff << "}\n";
@@ -357,7 +345,7 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
     VectorX armature(model.nq());
     for (int i = 1; i < model.num_bodies(); ++i)
       armature[i - 1] = model.joints[static_cast<std::size_t>(i)].armature;
-    y << "armature: " << list(armature) << '\n';
+    y << "armature: " << io_detail::yaml_list(armature) << '\n';
   }
   if (o.payload) {
     const Inertia& in = o.payload->inertia;
