@@ -20,6 +20,7 @@
 #include "extwrench/io/csv.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "support/random.hpp"
+#include "support/scratch_dir.hpp"
 
 namespace extwrench {
 namespace {
@@ -86,16 +87,9 @@ struct RunResult {
 };
 
 /// A scratch directory per test, removed afterwards.
-class Cli : public ::testing::Test {
+class Cli : public test::ScratchDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("extwrench_cli_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Cli() : ScratchDirTest("extwrench_cli") {}
 
   /// Runs the binary with `args` (already shell-quoted where needed), capturing both streams.
   RunResult run(const std::string& args, const std::string& stdin_file = "/dev/null") const {
@@ -113,8 +107,6 @@ class Cli : public ::testing::Test {
 
   fs::path path(const std::string& name) const { return dir_ / name; }
   std::string quoted(const std::string& name) const { return "'" + path(name).string() + "'"; }
-
-  fs::path dir_;
 };
 
 // ---- help and version --------------------------------------------------------------------

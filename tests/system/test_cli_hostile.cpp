@@ -19,6 +19,7 @@
 #include "extwrench/io/log.hpp"
 #include "extwrench/model/model_builder.hpp"
 #include "support/build_info.hpp"
+#include "support/scratch_dir.hpp"
 
 namespace extwrench {
 namespace {
@@ -53,16 +54,9 @@ const char* cli_binary() {
   return other != nullptr ? other : EXTWRENCH_CLI;
 }
 
-class Hostile : public ::testing::Test {
+class Hostile : public test::ScratchDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("extwrench_hostile_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Hostile() : ScratchDirTest("extwrench_hostile") {}
 
   // Runs `sh -c "<prefix> exec extwrench <args>"` under `timeout 20` (a FIFO must not hang the
   // suite), measuring wall time and the child's peak RSS.
@@ -97,8 +91,6 @@ class Hostile : public ::testing::Test {
       out += (out.empty() ? "" : ", ") + fs::relative(e.path(), dir).string();
     return out;
   }
-
-  fs::path dir_;
 };
 
 ::testing::AssertionResult contains(const std::string& text, const std::string& needle) {

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "support/scratch_dir.hpp"
 namespace extwrench {
 namespace {
 
@@ -33,16 +34,9 @@ std::string read_text(const fs::path& path) {
   return s.str();
 }
 
-class CliLock : public ::testing::Test {
+class CliLock : public test::ScratchDirTest {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("extwrench_cli_lock_" + std::string(info->name()) + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  CliLock() : ScratchDirTest("extwrench_cli_lock") {}
 
   RunResult run(const std::string& args) const {
     const fs::path out = dir_ / "stdout.txt";
@@ -56,8 +50,6 @@ class CliLock : public ::testing::Test {
     r.err = read_text(err);
     return r;
   }
-
-  fs::path dir_;
 };
 
 TEST_F(CliLock, InfoOnThePandaWithLockedFingersAndItsOwnDirectoryAsPackagePath) {
