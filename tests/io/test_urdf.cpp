@@ -14,12 +14,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-LoadOptions no_meshes() {
-  LoadOptions o;
-  o.load_meshes = false;
-  o.use_ros_package_path = false;
-  return o;
-}
+using test::no_meshes;
 
 std::string load_error(const fs::path& path, const LoadOptions& o) {
   try {

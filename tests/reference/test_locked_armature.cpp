@@ -44,12 +44,7 @@ std::string replaced(std::string text, const std::string& from, const std::strin
   return text;
 }
 
-LoadOptions no_meshes() {
-  LoadOptions o;
-  o.load_meshes = false;
-  o.use_ros_package_path = false;
-  return o;
-}
+using test::no_meshes;
 
 // ---- the Panda with its fingers locked -----------------------------------------------------
 

@@ -20,12 +20,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-LoadOptions no_meshes() {
-  LoadOptions o;
-  o.load_meshes = false;
-  o.use_ros_package_path = false;
-  return o;
-}
+using test::no_meshes;
 
 fs::path panda_dir() { return test::shared_models() / "franka_panda/urdf_example-robot-data"; }
 fs::path lwr_dir() { return test::shared_models() / "kuka_lwr4plus/urdf_flobaroid"; }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "extwrench/io/robot_loader.hpp"
 #include "extwrench/model/model.hpp"
 
 namespace extwrench::test {
@@ -64,6 +65,14 @@ inline Eigen::Isometry3d dh_modified(double a, double alpha, double d, double th
 inline bool near(const Pose& x, const Eigen::Isometry3d& t, double tol) {
   return (x.rotation - t.linear()).cwiseAbs().maxCoeff() < tol &&
          (x.translation - t.translation()).norm() < tol;
+}
+
+/// Load options for tests that read only the kinematics and inertias: no meshes, no ROS path.
+inline LoadOptions no_meshes() {
+  LoadOptions o;
+  o.load_meshes = false;
+  o.use_ros_package_path = false;
+  return o;
 }
 
 inline std::filesystem::path shared_models() {
