@@ -42,11 +42,11 @@ constexpr Config kTableI[] = {
 EstimatorOptions options_for(const Config& c, const Trajectory& tr) {
   EstimatorOptions o;
   o.sensor.type = c.sensor;
-  o.sensor.pose = tr.X_WS;
+  o.sensor.X_WS = tr.X_WS;
   o.contact.model = c.contact;
   if (c.contact == ContactModel::kKnownPoint) {
     o.contact.link = tr.contact.body;
-    o.contact.point = tr.contact.point_B;
+    o.contact.point_L = tr.contact.point_B;
   }
   o.observer_gain = VectorX::Constant(1, kGain);
   return o;

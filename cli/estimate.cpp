@@ -71,7 +71,7 @@ void run_estimate(const EstimateOptions& opt) {
   replay.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere
   if (config.options.sensor.type != SensorType::kNone) {
     std::cout << "extwrench estimate: base sensor pose X_WS: "
-              << pose_summary(config.options.sensor.pose) << " (" << config.sensor_pose_source
+              << pose_summary(config.options.sensor.X_WS) << " (" << config.sensor_pose_source
               << ")\n"
               << std::flush;
   }

@@ -40,7 +40,7 @@ int main(int argc, char** argv) {
   sim::ForceProfile push;  // the paper's contact: 20 N at a point of link 6, fixed in frame 6
   push.frame = "link6";
   push.force = Vector3(20.0, 0.0, 0.0);
-  push.point = Vector3(0.0, 0.0, 0.1);
+  push.point_F = Vector3(0.0, 0.0, 0.1);
   push.start = 1.0;
   push.end = 2.5;
   config.forces.push_back(push);
@@ -48,7 +48,7 @@ int main(int argc, char** argv) {
 
   EstimatorOptions options;
   options.sensor.type = SensorType::kForceTorque;
-  options.sensor.pose = X_WS;
+  options.sensor.X_WS = X_WS;
   options.contact.model = ContactModel::kPureForce;
   options.observer_gain = VectorX::Constant(1, argc > 2 ? std::atof(argv[2]) : 100.0);
   ContactEstimator estimator(model, robot.geometry, options);
@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
     }
     if (k % 100 != 0) continue;
     const ContactEstimate& e = estimator.result();
-    const double err = s.truth.contacts > 0 ? (e.force_W - s.truth.force).norm() : std::nan("");
+    const double err = s.truth.contacts > 0 ? (e.force_W - s.truth.force_W).norm() : std::nan("");
     std::printf("%6.2f %7d %5s [%7.2f %7.2f %7.2f] [%7.3f %7.3f %7.3f] %8.3f  %s\n", s.t,
                 e.contact ? 1 : 0, e.contact ? model.bodies[e.link].name.c_str() : "-",
                 e.force_W.x(), e.force_W.y(), e.force_W.z(), e.point_W.x(), e.point_W.y(),

@@ -43,7 +43,7 @@ double time_update_loop(const Estimator& source, const py::handle& t, const py::
     }
     if (R.data != nullptr) {
       s.has_force = s.has_moment = true;
-      for (py::ssize_t j = 0; j < R.cols; ++j) s.sensor[j] = R.at(k, j);
+      for (py::ssize_t j = 0; j < R.cols; ++j) s.reading_S[j] = R.at(k, j);
     }
   }
   ContactEstimator est = make_estimator(source.config);

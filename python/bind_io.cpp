@@ -48,11 +48,11 @@ py::dict read_log_py(const std::filesystem::path& path, const py::handle& robot)
     q.add(s.q.data());
     dq.add(s.dq.data());
     tau.add(s.tau.data());
-    if (layout.force) reading.add(s.sensor.data());
+    if (layout.force) reading.add(s.reading_S.data());
     if (layout.truth) {
-      force.add(s.truth.force.data());
-      moment.add(s.truth.moment.data());
-      point.add(s.truth.point.data());
+      force.add(s.truth.force_W.data());
+      moment.add(s.truth.moment_W.data());
+      point.add(s.truth.point_W.data());
       body.push_back(s.truth.body);
       contacts.push_back(s.truth.contacts);
       links.push_back(s.truth.link);
@@ -207,9 +207,9 @@ py::dict metrics_py(const py::dict& truth, const py::dict& estimates, double fro
   for (py::ssize_t k = 0; k < t.rows; ++k) {
     tr.body = static_cast<int>(body.at(k));
     tr.contacts = static_cast<int>(contacts.at(k));
-    tr.force = row3(force, k);
-    tr.moment = row3(moment, k);
-    tr.point = row3(point, k);
+    tr.force_W = row3(force, k);
+    tr.moment_W = row3(moment, k);
+    tr.point_W = row3(point, k);
     rows.get(k, e);
     acc.add(t.at(k), tr, e);
   }

@@ -45,12 +45,12 @@ int main(int argc, char** argv) {
       // A 20 N push on link 6 during the second half of every 10 s.
       const bool contact = std::fmod(t, 10.0) >= 5.0;
       s.t = t;
-      s.sensor << 1, 2, -170, 0.1, 0.2, 0.3;
+      s.reading_S << 1, 2, -170, 0.1, 0.2, 0.3;
       s.truth.link = contact ? "link6" : "";
       s.truth.body = contact ? 6 : -1;
       s.truth.contacts = contact ? 1 : 0;
-      s.truth.force << (contact ? 20.0 : 0.0), 0, 0;
-      s.truth.point << 0.1, 0.2, 0.8;
+      s.truth.force_W << (contact ? 20.0 : 0.0), 0, 0;
+      s.truth.point_W << 0.1, 0.2, 0.8;
       writer.write(s);
     }
     writer.close();

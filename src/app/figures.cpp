@@ -278,8 +278,8 @@ void FigureRecorder::estimate_columns(const Sample& s, const ContactEstimate& e,
 void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, double* r) {
   const bool touched = truth_ && s.truth.body >= 0;
   for (int k = 0; k < 3; ++k) {
-    r[kFt + k] = truth_ ? (touched ? s.truth.force[k] : 0.0) : kNaN;
-    r[kPt + k] = touched ? s.truth.point[k] : kNaN;
+    r[kFt + k] = truth_ ? (touched ? s.truth.force_W[k] : 0.0) : kNaN;
+    r[kPt + k] = touched ? s.truth.point_W[k] : kNaN;
   }
   r[kTrueContact] = touched ? 1.0 : 0.0;
   r[kCondTrue] = kNaN;
@@ -290,7 +290,7 @@ void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, do
   }
   r[kErrF] = kNaN;
   if (truth_) {
-    const Vector3 f_true = s.truth.body >= 0 ? s.truth.force : Vector3::Zero();
+    const Vector3 f_true = s.truth.body >= 0 ? s.truth.force_W : Vector3::Zero();
     const Vector3 f_est = e.contact && e.has(EstimateFlag::kForce) ? e.force_W : Vector3::Zero();
     r[kErrF] = (f_est - f_true).norm();
   }

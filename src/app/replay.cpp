@@ -164,7 +164,7 @@ void draw_figures(const detail::FigureRecorder& figures, const Model& model,
   fo.dir = o.out_dir;
   fo.title = title_of(o);
   fo.snapshots = o.snapshots;
-  fo.p_WS = e.sensor.pose.translation;
+  fo.p_WS = e.sensor.X_WS.translation;
   fo.max_condition = e.solver.max_condition;
   fo.format = o.figure_format;
   fo.geometry = &geometry;

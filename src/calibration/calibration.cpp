@@ -177,7 +177,7 @@ void sensor_calibration(const Model& model, const EstimatorOptions& options,
   EstimatorOptions opt = apply_calibration(options, cal);
   opt.sensor.tare_samples = 0;
   opt.sensor.bias_S.setZero();
-  const Pose& X_WS = opt.sensor.pose;
+  const Pose& X_WS = opt.sensor.X_WS;
   ContactEstimator est(model, GeometryModel{}, opt);
   Vector6 sum = Vector6::Zero();
   std::size_t count = 0;
@@ -193,7 +193,7 @@ void sensor_calibration(const Model& model, const EstimatorOptions& options,
         Vector6 predicted_S;
         predicted_S.head<3>() = X_WS.rotation.transpose() * predicted_W.head<3>();
         predicted_S.tail<3>() = X_WS.rotation.transpose() * predicted_W.tail<3>();
-        sum += samples[k].sensor - predicted_S;
+        sum += samples[k].reading_S - predicted_S;
         ++count;
       } else {
         const Vector3& f = est.result().force_W;

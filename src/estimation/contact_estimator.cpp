@@ -137,7 +137,7 @@ Status ContactEstimator::update(const Sample& s) noexcept {
     fail(s.t, {StatusCode::kWrongSize, Channel::kBaseWrench, 0});  // the sensor needs a reading
     return out_.status;
   }
-  return update(s.t, s.q, s.dq, s.tau, s.sensor);
+  return update(s.t, s.q, s.dq, s.tau, s.reading_S);
 }
 
 Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
@@ -349,7 +349,7 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
 // n_m − ñ_g (13) in W about O_s; the tare advanced (kTaring in `flags` while it runs).
 BaseWrench ContactEstimator::base_sensor_reading(const Vector6& reading_S,
                                                  std::uint32_t& flags) noexcept {
-  const Pose& X_WS = options_.sensor.pose;
+  const Pose& X_WS = options_.sensor.X_WS;
   // What the robot would discharge with this motion and no contact (f̃_g, ñ_g), world, about O_s.
   const Vector6 predicted_W = sensor_reading_world(data_, X_WS.translation);
   const BaseWrench base = base_wrench(options_.sensor.type, X_WS, reading_S, predicted_W, tare_);
@@ -368,7 +368,7 @@ int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& b
   in.tau_ext = &tau_ext_;
   in.tau_min = &detector_.tau_min();
   in.base = &base;
-  in.p_WS = options_.sensor.pose.translation;
+  in.p_WS = options_.sensor.X_WS.translation;
   const IsolationResult r = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
                                                 options_.solver, isolation_ws_);
   if (!r.decided) {
@@ -388,7 +388,7 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
   const Vector3& O_l = data_.X_WB[static_cast<std::size_t>(link)].translation;
   point_jacobian(model_, data_, link, O_l, J_);  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l
   WrenchFit fit = wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
-                              options_.sensor.pose.translation, options_.solver, b_, spectrum_);
+                              options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
   if (options_.sensor.type != SensorType::kForceTorque) out_.condition_number = fit.condition;
   if (fit.fitted_force) {
     out_.force_W = fit.force_W;
@@ -412,7 +412,7 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
 // observability). Out: fit.force_W, its basis, out_.force_W and kForce.
 void ContactEstimator::known_point_force(int link, WrenchFit& fit, std::uint32_t& flags) noexcept {
   const Pose& X_WL = data_.X_WB[static_cast<std::size_t>(link)];
-  point_jacobian(model_, data_, link, X_WL.act(options_.contact.point), J_);
+  point_jacobian(model_, data_, link, X_WL.act(options_.contact.point_L), J_);
   Vector3 x;
   Matrix3 basis;
   const int rank =
@@ -435,9 +435,9 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
   const Pose& X_WL = data_.X_WB[static_cast<std::size_t>(link)];
   const Vector3& O_l = X_WL.translation;
   if (options_.contact.model == ContactModel::kKnownPoint) {
-    const Vector3 p_W = X_WL.act(options_.contact.point);
+    const Vector3 p_W = X_WL.act(options_.contact.point_L);
     out_.point_W = p_W;
-    out_.point_L = options_.contact.point;
+    out_.point_L = options_.contact.point_L;
     flags |= EstimateFlag::kKnownPoint;
     if (fit.ok) {
       out_.moment_W = known_point_moment(fit, p_W, O_l);

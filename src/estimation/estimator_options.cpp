@@ -15,11 +15,11 @@ void validate_contact(const ContactOptions& c, const Model& model, const std::st
     throw Error(where + ": contact.link: body index " + std::to_string(c.link) + " is not in [0, " +
                 std::to_string(model.num_bodies() - 1) + "]");
   }
-  if (!c.point.allFinite()) throw Error(where + ": contact.point: expected finite values");
+  if (!c.point_L.allFinite()) throw Error(where + ": contact.point: expected finite values");
 }
 
 void validate_sensor(const SensorOptions& s, const std::string& where) {
-  const Pose& X = s.pose;
+  const Pose& X = s.X_WS;
   if (!X.translation.allFinite() || !X.rotation.allFinite() ||
       !(X.rotation * X.rotation.transpose()).isIdentity(1e-9) || X.rotation.determinant() < 0) {
     throw Error(where + ": sensor.pose: expected a finite rigid transform");

@@ -34,7 +34,7 @@ ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o,
   if (shape.mesh == nullptr) {
     ShapeClosestPoint cp;
     cp.distance = kInf;
-    cp.point.setConstant(kNaN);
+    cp.point_G.setConstant(kNaN);
     cp.lambda = kNaN;
     return cp;
   }
@@ -43,26 +43,26 @@ ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o,
 
 }  // namespace
 
-int intersect_line_with_shape(const CollisionShape& shape, const Vector3& origin_S,
-                              const Vector3& direction_S, std::span<ShapeHit> hits) noexcept {
+int intersect_line_with_shape(const CollisionShape& shape, const Vector3& origin_G,
+                              const Vector3& direction_G, std::span<ShapeHit> hits) noexcept {
   HitSink sink(hits);
-  collect_hits(shape, origin_S, direction_S, sink);
+  collect_hits(shape, origin_G, direction_G, sink);
   return sink.size();
 }
 
-ShapeClosestPoint closest_point_to_line(const CollisionShape& shape, const Vector3& origin_S,
-                                        const Vector3& direction_S) noexcept {
+ShapeClosestPoint closest_point_to_line(const CollisionShape& shape, const Vector3& origin_G,
+                                        const Vector3& direction_G) noexcept {
   std::array<ShapeHit, 1> first;
   HitSink sink(first);
-  collect_hits(shape, origin_S, direction_S, sink);
+  collect_hits(shape, origin_G, direction_G, sink);
   if (sink.distinct() > 0) {
     ShapeClosestPoint cp;
-    cp.point = sink.first().point;
+    cp.point_G = sink.first().point_G;
     cp.lambda = sink.first().lambda;
     cp.distance = 0.0;
     return cp;
   }
-  return closest_on_miss(shape, origin_S, direction_S);
+  return closest_on_miss(shape, origin_G, direction_G);
 }
 
 SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int body,
@@ -87,26 +87,26 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
   const Vector3 u_W = direction_W / norm;
   const int num_shapes = static_cast<int>(geometry.shapes.size());
 
-  const auto to_shape = [&](const CollisionShape& shape, Pose& X_WS, Vector3& o_S, Vector3& u_S) {
-    X_WS = X_WB * shape.placement;
-    o_S.noalias() = X_WS.rotation.transpose() * (point_on_line_W - X_WS.translation);
-    u_S.noalias() = X_WS.rotation.transpose() * u_W;
+  const auto to_shape = [&](const CollisionShape& shape, Pose& X_WG, Vector3& o_G, Vector3& u_G) {
+    X_WG = X_WB * shape.placement;
+    o_G.noalias() = X_WG.rotation.transpose() * (point_on_line_W - X_WG.translation);
+    u_G.noalias() = X_WG.rotation.transpose() * u_W;
   };
 
   std::array<ShapeHit, kMaxHitsPerShape> buffer;
   for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
     if (s < 0 || s >= num_shapes) continue;
     const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
-    Pose X_WS;
-    Vector3 o_S, u_S;
-    to_shape(shape, X_WS, o_S, u_S);
+    Pose X_WG;
+    Vector3 o_G, u_G;
+    to_shape(shape, X_WG, o_G, u_G);
     HitSink sink(buffer);
-    collect_hits(shape, o_S, u_S, sink);
+    collect_hits(shape, o_G, u_G, sink);
     if (sink.distinct() == 0) continue;
     result.num_hits += sink.distinct();
     const bool is_mesh = shape.type == ShapeType::kMesh;
     const auto to_world = [&](const ShapeHit& h, double orient) {
-      LineHit w{h.lambda, X_WS.act(h.point), X_WS.rotation * h.normal, s};
+      LineHit w{h.lambda, X_WG.act(h.point_G), X_WG.rotation * h.normal_G, s};
       // Mesh winding may be inward: the entry faces −u, the exit +u on a closed surface.
       if (is_mesh && orient * w.normal_W.dot(u_W) < 0.0) w.normal_W = -w.normal_W;
       return w;
@@ -128,13 +128,13 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
   for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
     if (s < 0 || s >= num_shapes) continue;
     const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
-    Pose X_WS;
-    Vector3 o_S, u_S;
-    to_shape(shape, X_WS, o_S, u_S);
-    const ShapeClosestPoint cp = closest_on_miss(shape, o_S, u_S);
+    Pose X_WG;
+    Vector3 o_G, u_G;
+    to_shape(shape, X_WG, o_G, u_G);
+    const ShapeClosestPoint cp = closest_on_miss(shape, o_G, u_G);
     if (cp.distance < result.distance) {
       result.distance = cp.distance;
-      result.closest_point_W = X_WS.act(cp.point);
+      result.closest_point_W = X_WG.act(cp.point_G);
       result.closest_lambda = cp.lambda;
       result.shape = s;
     }

@@ -36,8 +36,8 @@ bool line_triangle(const TriangleMesh& mesh, int tri, const Vector3& o, const Ve
   const double b2 = u.dot(qv) * inv_det;
   if (b2 < -slack || b1 + b2 > 1.0 + slack) return false;
   hit.lambda = e2.dot(qv) * inv_det;
-  hit.point = o + hit.lambda * u;
-  hit.normal = e1.cross(e2).normalized();
+  hit.point_G = o + hit.lambda * u;
+  hit.normal_G = e1.cross(e2).normalized();
   return true;
 }
 
@@ -108,7 +108,7 @@ ShapeClosestPoint mesh_closest_on_miss(const TriangleMesh& m, const Vector3& o,
                                        const Vector3& u) noexcept {
   ShapeClosestPoint cp;
   cp.distance = kInf;
-  cp.point.setConstant(kNaN);
+  cp.point_G.setConstant(kNaN);
   cp.lambda = kNaN;
   Vector3 e1, e2;
   orthonormal_basis(u, e1, e2);
@@ -138,8 +138,8 @@ ShapeClosestPoint mesh_closest_on_miss(const TriangleMesh& m, const Vector3& o,
   if (best_t < 0) return cp;
   const Vector3 a = m.vertices.col(m.triangles(best_k, best_t));
   const Vector3 b = m.vertices.col(m.triangles((best_k + 1) % 3, best_t));
-  cp.point = a + best_s * (b - a);
-  cp.lambda = u.dot(cp.point - o);
+  cp.point_G = a + best_s * (b - a);
+  cp.lambda = u.dot(cp.point_G - o);
   cp.distance = std::sqrt(best);
   return cp;
 }

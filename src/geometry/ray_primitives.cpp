@@ -31,8 +31,8 @@ void sphere_hits(double r, const Vector3& c, const Vector3& o, const Vector3& u,
   for (const double l : {l0 - h, l0 + h}) {
     ShapeHit& hit = out[n++];
     hit.lambda = l;
-    hit.point = o + l * u;
-    hit.normal = (hit.point - c) / r;
+    hit.point_G = o + l * u;
+    hit.normal_G = (hit.point_G - c) / r;
   }
 }
 
@@ -63,13 +63,13 @@ int box_hits(const Vector3& half, const Vector3& o, const Vector3& u, ShapeHit* 
   const double s_near = u[i_near] > 0.0 ? -1.0 : 1.0;
   const double s_far = u[i_far] > 0.0 ? 1.0 : -1.0;
   out[0].lambda = t_near;
-  out[0].point = o + t_near * u;
-  out[0].point[i_near] = s_near * half[i_near];
-  out[0].normal = s_near * Vector3::Unit(i_near);
+  out[0].point_G = o + t_near * u;
+  out[0].point_G[i_near] = s_near * half[i_near];
+  out[0].normal_G = s_near * Vector3::Unit(i_near);
   out[1].lambda = t_far;
-  out[1].point = o + t_far * u;
-  out[1].point[i_far] = s_far * half[i_far];
-  out[1].normal = s_far * Vector3::Unit(i_far);
+  out[1].point_G = o + t_far * u;
+  out[1].point_G[i_far] = s_far * half[i_far];
+  out[1].normal_G = s_far * Vector3::Unit(i_far);
   return 2;
 }
 
@@ -99,8 +99,8 @@ bool lateral_interval(double r, const Vector3& o, const Vector3& u, double& t1,
 ShapeHit lateral_hit(double r, const Vector3& o, const Vector3& u, double t) noexcept {
   ShapeHit hit;
   hit.lambda = t;
-  hit.point = o + t * u;
-  hit.normal = Vector3(hit.point.x(), hit.point.y(), 0.0) / r;
+  hit.point_G = o + t * u;
+  hit.normal_G = Vector3(hit.point_G.x(), hit.point_G.y(), 0.0) / r;
   return hit;
 }
 
@@ -127,9 +127,9 @@ int cylinder_hits(double r, double hl, const Vector3& o, const Vector3& u, Shape
   const auto cap_hit = [&](double t, double sign) {
     ShapeHit hit;
     hit.lambda = t;
-    hit.point = o + t * u;
-    hit.point.z() = sign * hl;
-    hit.normal = sign * Vector3::UnitZ();
+    hit.point_G = o + t * u;
+    hit.point_G.z() = sign * hl;
+    hit.normal_G = sign * Vector3::UnitZ();
     return hit;
   };
   out[0] = near_cap ? cap_hit(t_near, u.z() > 0.0 ? -1.0 : 1.0) : lateral_hit(r, o, u, t_near);
@@ -149,7 +149,7 @@ int capsule_hits(double r, double hl, const Vector3& o, const Vector3& u, ShapeH
   if (lateral_interval(r, o, u, t1, t2) && std::isfinite(t1)) {
     for (const double t : {t1, t2}) {
       const ShapeHit hit = lateral_hit(r, o, u, t);
-      if (std::abs(hit.point.z()) <= hl) c[n++] = hit;
+      if (std::abs(hit.point_G.z()) <= hl) c[n++] = hit;
     }
   }
   if (n == 0) return 0;
@@ -214,8 +214,8 @@ ShapeClosestPoint golden_closest(const Vector3& o, const Vector3& u, double boun
   ShapeClosestPoint cp;
   cp.lambda = 0.5 * (a + b);
   const Vector3 p = o + cp.lambda * u;
-  cp.point = project(p);
-  cp.distance = (p - cp.point).norm();
+  cp.point_G = project(p);
+  cp.distance = (p - cp.point_G).norm();
   return cp;
 }
 
@@ -251,7 +251,8 @@ ShapeClosestPoint primitive_closest_on_miss(const CollisionShape& shape, const V
       cp.lambda = -o.dot(u);
       const Vector3 f = o + cp.lambda * u;
       const double d = f.norm();
-      cp.point = d > 0.0 ? Vector3(shape.radius / d * f) : Vector3(shape.radius * Vector3::UnitZ());
+      cp.point_G =
+          d > 0.0 ? Vector3(shape.radius / d * f) : Vector3(shape.radius * Vector3::UnitZ());
       cp.distance = std::max(d - shape.radius, 0.0);
       return cp;
     }
@@ -262,8 +263,8 @@ ShapeClosestPoint primitive_closest_on_miss(const CollisionShape& shape, const V
                                                 cp.lambda, axis_distance);
       const Vector3 to_line = o + cp.lambda * u - q;
       const double n = to_line.norm();
-      cp.point = q + (n > 0.0 ? Vector3(shape.radius / n * to_line)
-                              : Vector3(shape.radius * Vector3::UnitX()));
+      cp.point_G = q + (n > 0.0 ? Vector3(shape.radius / n * to_line)
+                                : Vector3(shape.radius * Vector3::UnitX()));
       cp.distance = std::max(axis_distance - shape.radius, 0.0);
       return cp;
     }

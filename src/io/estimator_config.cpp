@@ -24,7 +24,7 @@ void read_sensor(const YamlReader& rd, const YAML::Node& sensor, SensorOptions& 
   rd.only_keys(sensor, "sensor", {"type", "pose", "tare", "bias"});
   if (!sensor["type"]) rd.fail(sensor, "sensor.type", "missing (ft | force | none)");
   o.type = rd.sensor_type(sensor["type"], "sensor.type");
-  if (sensor["pose"]) o.pose = rd.pose(sensor["pose"], "sensor.pose");
+  if (sensor["pose"]) o.X_WS = rd.pose(sensor["pose"], "sensor.pose");
   if (sensor["bias"]) o.bias_S = rd.vector(sensor["bias"], "sensor.bias", 6);
   if (const YAML::Node t = sensor["tare"]) {
     if (YamlReader::is_boolean(t)) {
@@ -52,7 +52,7 @@ void read_contact(const YamlReader& rd, const YAML::Node& c, const Model& model,
   o.model = ContactModel::kKnownPoint;
   if (!c["link"]) rd.fail(c, "contact.link", "missing (required with contact.model: known_point)");
   o.link = rd.body(model, c["link"], "contact.link");
-  if (c["point"]) o.point = rd.vector3(c["point"], "contact.point");
+  if (c["point"]) o.point_L = rd.vector3(c["point"], "contact.point");
 }
 
 void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorOptions& o) {
@@ -234,11 +234,12 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (!root["sensor"])
     rd.fail(root, "sensor", "missing (needs at least sensor.type: ft | force | none)");
   read_sensor(rd, root["sensor"], o.sensor);
-  // One rule everywhere (dynamics, simulate): without sensor.pose, the model's 'sensor' frame.
+  // One rule everywhere (dynamics, simulate): without sensor.pose in the file, the model's 'sensor'
+  // frame.
   if (root["sensor"]["pose"]) {
     cfg.sensor_pose_source = "sensor.pose";
   } else {
-    o.sensor.pose = default_sensor_pose(model);
+    o.sensor.X_WS = default_sensor_pose(model);
     cfg.sensor_pose_source = describe_default_sensor_pose(model);
   }
   if (root["contact"]) read_contact(rd, root["contact"], model, o.contact);
@@ -320,15 +321,15 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   }
   y << "gravity: " << list3(model.gravity) << '\n';
   y << "sensor:\n  type: " << to_string(o.sensor.type) << '\n';
-  y << "  pose: {xyz: " << list3(o.sensor.pose.translation)
-    << ", rpy: " << list3(rpy_from_rotation(o.sensor.pose.rotation)) << "}\n";
+  y << "  pose: {xyz: " << list3(o.sensor.X_WS.translation)
+    << ", rpy: " << list3(rpy_from_rotation(o.sensor.X_WS.rotation)) << "}\n";
   y << "  tare: " << o.sensor.tare_samples << '\n';
   if (!o.sensor.bias_S.isZero(0.0))
     y << "  bias: " << io_detail::yaml_list(VectorX(o.sensor.bias_S)) << '\n';
   y << "contact:\n  model: " << to_string(o.contact.model) << '\n';
   if (o.contact.model == ContactModel::kKnownPoint) {
     y << "  link: " << model.bodies[static_cast<std::size_t>(o.contact.link)].name << '\n';
-    y << "  point: " << list3(o.contact.point) << '\n';
+    y << "  point: " << list3(o.contact.point_L) << '\n';
   }
   y << "observer:\n  gain: " << io_detail::yaml_list(o.observer_gain) << '\n';
   y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min)

@@ -126,10 +126,10 @@ bool LogReader::read_row(Sample& s) {
   s.has_force = layout_.force;
   s.has_moment = layout_.moment;
   for (int k = 0; k < 3 && layout_.force; ++k)
-    s.sensor[k] = csv_.number(col_fs_[static_cast<std::size_t>(k)]);
+    s.reading_S[k] = csv_.number(col_fs_[static_cast<std::size_t>(k)]);
   for (int k = 0; k < 3; ++k)
-    s.sensor[3 + k] = layout_.moment ? csv_.number(col_ms_[static_cast<std::size_t>(k)]) : 0.0;
-  if (!layout_.force) s.sensor.head<3>().setZero();
+    s.reading_S[3 + k] = layout_.moment ? csv_.number(col_ms_[static_cast<std::size_t>(k)]) : 0.0;
+  if (!layout_.force) s.reading_S.head<3>().setZero();
   s.has_truth = layout_.truth;
   s.has_true_tau_ext = layout_.true_tau_ext;
   if (layout_.truth) {
@@ -170,9 +170,9 @@ bool LogReader::read_row(Sample& s) {
         v[k] = std::isnan(x) ? 0.0 : x;
       }
     };
-    vec3(col_f_, tr.force);
-    vec3(col_m_, tr.moment);
-    vec3(col_p_, tr.point);
+    vec3(col_f_, tr.force_W);
+    vec3(col_m_, tr.moment_W);
+    vec3(col_p_, tr.point_W);
   }
   if (layout_.true_tau_ext) read_vector(col_tau_ext_, s.truth.tau_ext);
   return true;
@@ -225,17 +225,17 @@ void LogWriter::write(const Sample& s) {
     for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.dq[i]);
   for (Eigen::Index i = 0; i < layout_.n; ++i) csv_.add(s.tau[i]);
   if (layout_.force)
-    for (int k = 0; k < 3; ++k) csv_.add(s.sensor[k]);
+    for (int k = 0; k < 3; ++k) csv_.add(s.reading_S[k]);
   if (layout_.force && layout_.moment)
-    for (int k = 3; k < 6; ++k) csv_.add(s.sensor[k]);
+    for (int k = 3; k < 6; ++k) csv_.add(s.reading_S[k]);
   if (layout_.truth) {
     csv_.add(std::string_view(s.truth.link));
-    for (int k = 0; k < 3; ++k) csv_.add(s.truth.force[k]);
-    for (int k = 0; k < 3; ++k) csv_.add(s.truth.moment[k]);
+    for (int k = 0; k < 3; ++k) csv_.add(s.truth.force_W[k]);
+    for (int k = 0; k < 3; ++k) csv_.add(s.truth.moment_W[k]);
     // The point of a free sample means nothing: left empty.
     for (int k = 0; k < 3; ++k) {
       if (s.truth.body >= 0) {
-        csv_.add(s.truth.point[k]);
+        csv_.add(s.truth.point_W[k]);
       } else {
         csv_.add_empty();
       }

@@ -57,7 +57,7 @@ sim::ForceProfile parse_force(const YamlReader& y, const YAML::Node& node, const
   }
   if (node["force"]) f.force = y.vector3(node["force"], k + ".force");
   if (node["moment"]) f.moment = y.vector3(node["moment"], k + ".moment");
-  if (node["point"]) f.point = y.vector3(node["point"], k + ".point");
+  if (node["point"]) f.point_F = y.vector3(node["point"], k + ".point");
   if (node["start"]) f.start = y.number(node["start"], k + ".start");
   if (node["end"]) f.end = y.number(node["end"], k + ".end");
   if (node["ramp"]) f.ramp = y.number_in(node["ramp"], k + ".ramp", non_negative());
@@ -70,12 +70,12 @@ void parse_base_sensor(const YamlReader& y, const YAML::Node& b, sim::BaseSensor
   y.only_keys(b, "sensors.base", {"type", "pose", "bias", "force_noise", "moment_noise"});
   if (b["type"]) base.type = y.sensor_type(b["type"], "sensors.base.type");
   if (b["pose"]) base.X_WS = y.pose(b["pose"], "sensors.base.pose");
-  if (b["bias"]) base.bias = y.vector(b["bias"], "sensors.base.bias", 6);
+  if (b["bias"]) base.bias_S = y.vector(b["bias"], "sensors.base.bias", 6);
   if (b["force_noise"])
-    base.force_noise = y.vector(b["force_noise"], "sensors.base.force_noise", 3);
+    base.force_noise_S = y.vector(b["force_noise"], "sensors.base.force_noise", 3);
   if (b["moment_noise"])
-    base.moment_noise = y.vector(b["moment_noise"], "sensors.base.moment_noise", 3);
-  if ((base.force_noise.array() < 0).any() || (base.moment_noise.array() < 0).any()) {
+    base.moment_noise_S = y.vector(b["moment_noise"], "sensors.base.moment_noise", 3);
+  if ((base.force_noise_S.array() < 0).any() || (base.moment_noise_S.array() < 0).any()) {
     y.fail(b, "sensors.base", "noise standard deviations must be >= 0");
   }
 }

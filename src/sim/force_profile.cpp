@@ -28,7 +28,7 @@ bool ForceProfile::evaluate(double t, const Data& data, ExternalWrench& out) con
   if (s == 0.0 || body < 0) return false;
   const Pose X_WF = data.X_WB[static_cast<std::size_t>(body)] * X_BF;
   out.body = body;
-  out.point_W = X_WF.act(point);
+  out.point_W = X_WF.act(point_F);
   if (axes == Axes::kFrame) {
     out.force_W = s * (X_WF.rotation * force);
     out.moment_W = s * (X_WF.rotation * moment);

@@ -63,8 +63,8 @@ void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate
   if (!m_.window.contains(t)) return;
   ++m_.samples;
   // Force and moment errors: no detection means F̂ = 0, M̂ = 0; free means F = 0, M = 0.
-  const Vector3 f_true = touched ? truth.force : Vector3::Zero();
-  const Vector3 m_true = touched ? truth.moment : Vector3::Zero();
+  const Vector3 f_true = touched ? truth.force_W : Vector3::Zero();
+  const Vector3 m_true = touched ? truth.moment_W : Vector3::Zero();
   if (!est.contact) {
     m_.force.add(f_true.norm());
   } else if (est.has(EstimateFlag::kForce)) {
@@ -91,12 +91,12 @@ void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate
     ++m_.right_link;
   }
   if (est.contact && est.has(EstimateFlag::kLineOfAction)) {
-    m_.line.add(point_line_distance(truth.point, est.line_point_W, est.line_direction_W));
+    m_.line.add(point_line_distance(truth.point_W, est.line_point_W, est.line_direction_W));
   } else {
     ++m_.line_not_estimated;
   }
   if (est.contact && est.has(EstimateFlag::kSurfacePoint))
-    m_.surface.add((est.point_W - truth.point).norm());
+    m_.surface.add((est.point_W - truth.point_W).norm());
 }
 
 Metrics MetricsAccumulator::result() const { return m_; }

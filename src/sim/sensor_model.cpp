@@ -6,9 +6,9 @@
 namespace extwrench::sim {
 
 Vector6 BaseSensorModel::measure(const Vector6& ideal, Rng& rng) const noexcept {
-  Vector6 out = ideal + bias;
-  for (int k = 0; k < 3; ++k) out[k] += force_noise[k] * rng.normal();
-  for (int k = 0; k < 3; ++k) out[3 + k] += moment_noise[k] * rng.normal();
+  Vector6 out = ideal + bias_S;
+  for (int k = 0; k < 3; ++k) out[k] += force_noise_S[k] * rng.normal();
+  for (int k = 0; k < 3; ++k) out[3 + k] += moment_noise_S[k] * rng.normal();
   return out;
 }
 

@@ -117,11 +117,11 @@ bool Simulator::next(Sample& out) {
   const VectorX ddq = ws_.data.ddq;
   rnea(model_, ws_.data, q_, dq_, ddq, ws_.wrenches);
   const Vector6 ideal = sensor_reading(ws_.data, config_.sensor.X_WS);
-  out.sensor = config_.sensor.measure(ideal, noise_);
+  out.reading_S = config_.sensor.measure(ideal, noise_);
   out.has_force = config_.sensor.type != SensorType::kNone;
   out.has_moment = config_.sensor.type == SensorType::kForceTorque;
-  if (!out.has_force) out.sensor.setZero();
-  if (!out.has_moment) out.sensor.tail<3>().setZero();
+  if (!out.has_force) out.reading_S.setZero();
+  if (!out.has_moment) out.reading_S.tail<3>().setZero();
 
   out.has_truth = true;
   out.has_true_tau_ext = true;
@@ -129,20 +129,20 @@ bool Simulator::next(Sample& out) {
   truth.link.clear();
   truth.body = -1;
   truth.contacts = static_cast<int>(ws_.wrenches.size());
-  truth.force.setZero();
-  truth.moment.setZero();
-  truth.point.setZero();
+  truth.force_W.setZero();
+  truth.moment_W.setZero();
+  truth.point_W.setZero();
   for (const ExternalWrench& w : ws_.wrenches) {
     const std::string& name = model_.bodies[static_cast<std::size_t>(w.body)].name;
     if (truth.body < 0) {
       truth.body = w.body;
-      truth.point = w.point_W;
+      truth.point_W = w.point_W;
       truth.link = name;
     } else if (w.body != truth.body) {
       truth.link += "+" + name;
     }
-    truth.force += w.force_W;
-    truth.moment += w.moment_W;
+    truth.force_W += w.force_W;
+    truth.moment_W += w.moment_W;
   }
   truth.tau_ext = ws_.tau_ext;
 

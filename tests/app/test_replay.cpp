@@ -84,14 +84,14 @@ Sample random_sample(test::SeededRng& rng, double t, int n) {
   s.dq = rng.uniform_vector(n, -1, 1);
   s.tau = rng.uniform_vector(n, -50, 50);
   s.has_force = s.has_moment = true;
-  s.sensor = Vector6(rng.uniform_vector(6, -100, 100));
+  s.reading_S = Vector6(rng.uniform_vector(6, -100, 100));
   s.has_truth = s.has_true_tau_ext = true;
   s.truth.link = "link6";
   s.truth.body = 6;
   s.truth.contacts = 1;
-  s.truth.force = rng.uniform_vector3(-20, 20);
-  s.truth.moment = rng.uniform_vector3(-1, 1);
-  s.truth.point = rng.uniform_vector3(-1, 1);
+  s.truth.force_W = rng.uniform_vector3(-20, 20);
+  s.truth.moment_W = rng.uniform_vector3(-1, 1);
+  s.truth.point_W = rng.uniform_vector3(-1, 1);
   s.truth.tau_ext = rng.uniform_vector(n, -5, 5);
   return s;
 }
@@ -123,13 +123,13 @@ TEST_F(Replay, LogWrittenThenReadGivesBackEveryNumberBitForBit) {
     EXPECT_EQ(s.q, e.q);
     EXPECT_EQ(s.dq, e.dq);
     EXPECT_EQ(s.tau, e.tau);
-    EXPECT_EQ(s.sensor, e.sensor);
+    EXPECT_EQ(s.reading_S, e.reading_S);
     EXPECT_EQ(s.truth.link, e.truth.link);
     EXPECT_EQ(s.truth.body, e.truth.body);
-    EXPECT_EQ(s.truth.force, e.truth.force);
-    EXPECT_EQ(s.truth.moment, e.truth.moment);
+    EXPECT_EQ(s.truth.force_W, e.truth.force_W);
+    EXPECT_EQ(s.truth.moment_W, e.truth.moment_W);
     if (e.truth.body >= 0) {
-      EXPECT_EQ(s.truth.point, e.truth.point);
+      EXPECT_EQ(s.truth.point_W, e.truth.point_W);
     }
     EXPECT_EQ(s.truth.tau_ext, e.truth.tau_ext);
   }
@@ -513,9 +513,9 @@ void write_synthetic_log(const fs::path& path, long rows) {
       s.tau[i] = 10.0 * std::sin(0.2 * t + i);
     }
     s.t = t;
-    s.sensor << 1, 2, -170, 0.1, 0.2, 0.3;
-    s.truth.force << 20, 0, 0;
-    s.truth.point << 0.1, 0.2, 0.8;
+    s.reading_S << 1, 2, -170, 0.1, 0.2, 0.3;
+    s.truth.force_W << 20, 0, 0;
+    s.truth.point_W << 0.1, 0.2, 0.8;
     w.write(s);
   }
   w.close();

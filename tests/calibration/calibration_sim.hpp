@@ -67,9 +67,9 @@ inline std::vector<Sample> simulate_free_motion(const Model& model,
   config.sample_time = 1e-3;
   config.sensor.type = SensorType::kForceTorque;
   config.sensor.X_WS = Pose();
-  config.sensor.bias = sensor_bias;
-  config.sensor.force_noise = Vector3::Constant(0.2);
-  config.sensor.moment_noise = Vector3::Constant(0.02);
+  config.sensor.bias_S = sensor_bias;
+  config.sensor.force_noise_S = Vector3::Constant(0.2);
+  config.sensor.moment_noise_S = Vector3::Constant(0.02);
   config.noise_seed = seed;
   config.forces = std::move(forces);
   sim::Simulator simulator(model, controller, config);

@@ -95,7 +95,7 @@ TEST(Calibration, FitResidualIsTheObserverResidualWithTheFittedFriction) {
 TEST(CalibrationInput, ShortContactIsExcludedAndNamedWithItsWindow) {
   sim::ForceProfile push;
   push.frame = "link5";
-  push.point = Vector3(0.1, 0, 0);
+  push.point_F = Vector3(0.1, 0, 0);
   push.force = Vector3(0, 30, 0);
   push.start = 6.0;
   push.end = 6.5;
@@ -115,7 +115,7 @@ TEST(CalibrationInput, ShortContactIsExcludedAndNamedWithItsWindow) {
 TEST(CalibrationInput, LongContactIsRefusedOrWarnedWithItsWindow) {
   sim::ForceProfile push;
   push.frame = "link6";
-  push.point = Vector3(0.1, 0, 0);
+  push.point_F = Vector3(0.1, 0, 0);
   push.force = Vector3(0, 20, 0);
   push.start = 3.0;
   push.end = 5.0;

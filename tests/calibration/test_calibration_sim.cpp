@@ -101,7 +101,7 @@ TEST(CalibrationSim, DetectsATenNewtonPushOnEveryLinkWithinFiftyMilliseconds) {
     sim::ForceProfile push;
     push.frame = "link" + std::to_string(link);
     push.axes = sim::ForceProfile::Axes::kFrame;
-    push.point = Vector3(0.1, 0.0, 0.0);
+    push.point_F = Vector3(0.1, 0.0, 0.0);
     push.force = Vector3(0.0, 10.0, 0.0);
     push.start = 2.0;
     push.end = 3.0;

@@ -63,7 +63,7 @@ TEST(PartialObservability, PlanarChainWithAKnownPointGetsItsInPlaneForce) {
   opt.sensor.type = SensorType::kNone;
   opt.contact.model = ContactModel::kKnownPoint;
   opt.contact.link = 2;
-  opt.contact.point = Vector3(kL2, 0, 0.05);
+  opt.contact.point_L = Vector3(kL2, 0, 0.05);
   opt.detection.min_duration = 0.0;
   ContactEstimator est(model, GeometryModel{}, opt);
   const VectorX zero = VectorX::Zero(2);

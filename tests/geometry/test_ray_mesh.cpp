@@ -127,8 +127,8 @@ TEST(RayMesh, GeneratedBoxFromAnStlFileMatchesTheAnalyticBox) {
     for (int i = 0; i < n; ++i) {
       const auto k = static_cast<std::size_t>(i);
       EXPECT_NEAR(embree[k].lambda, expected[k].lambda, kExactTolerance);
-      EXPECT_LT((embree[k].point - (expected[k].point + centre)).norm(), kExactTolerance);
-      EXPECT_LT((embree[k].normal - expected[k].normal).norm(), 1e-12);
+      EXPECT_LT((embree[k].point_G - (expected[k].point_G + centre)).norm(), kExactTolerance);
+      EXPECT_LT((embree[k].normal_G - expected[k].normal_G).norm(), 1e-12);
       EXPECT_NEAR(loop[k].lambda, expected[k].lambda, kExactTolerance);
     }
     hitting += n > 0;
@@ -162,8 +162,8 @@ TEST(RayMesh, IcosphereFromAnObjFileMatchesItsHalfSpaceDescription) {
       EXPECT_NEAR(embree[1].lambda, exit, kExactTolerance);
       EXPECT_NEAR(loop[0].lambda, entry, kExactTolerance);
       EXPECT_NEAR(loop[1].lambda, exit, kExactTolerance);
-      EXPECT_LT(embree[0].normal.dot(u), 0.0);
-      EXPECT_GT(embree[1].normal.dot(u), 0.0);
+      EXPECT_LT(embree[0].normal_G.dot(u), 0.0);
+      EXPECT_GT(embree[1].normal_G.dot(u), 0.0);
       ++hitting;
     }
   }
@@ -181,10 +181,10 @@ TEST(RayMesh, ScaleIsAppliedPerAxisAndMirroringKeepsNormalsOutward) {
     std::array<ShapeHit, 4> hits;
     ASSERT_EQ(intersect_line_with_shape(mesh, Vector3(-3.0, 0.01, 0.02), Vector3::UnitX(), hits),
               2);
-    EXPECT_NEAR(hits[0].point.x(), -0.5, 1e-15);  // 0.25 × |2|
-    EXPECT_NEAR(hits[1].point.x(), 0.5, 1e-15);
-    EXPECT_LT((hits[0].normal + Vector3::UnitX()).norm(), 1e-15);
-    EXPECT_LT((hits[1].normal - Vector3::UnitX()).norm(), 1e-15);
+    EXPECT_NEAR(hits[0].point_G.x(), -0.5, 1e-15);  // 0.25 × |2|
+    EXPECT_NEAR(hits[1].point_G.x(), 0.5, 1e-15);
+    EXPECT_LT((hits[0].normal_G + Vector3::UnitX()).norm(), 1e-15);
+    EXPECT_LT((hits[1].normal_G - Vector3::UnitX()).norm(), 1e-15);
   }
 }
 

@@ -69,12 +69,12 @@ TEST(RayPrimitives, HitsLieOnTheSurfaceAndOnTheLineWithOutwardNormals) {
       if (n == 2) ++lines_hitting;
       for (int i = 0; i < n; ++i) {
         const ShapeHit& h = hits[static_cast<std::size_t>(i)];
-        EXPECT_NEAR(test::implicit(shape, h.point), 0.0, kSurfaceTolerance);
-        EXPECT_LT((h.point - (o + h.lambda * u)).norm(), kSurfaceTolerance);
-        EXPECT_NEAR(h.normal.norm(), 1.0, 1e-14);
+        EXPECT_NEAR(test::implicit(shape, h.point_G), 0.0, kSurfaceTolerance);
+        EXPECT_LT((h.point_G - (o + h.lambda * u)).norm(), kSurfaceTolerance);
+        EXPECT_NEAR(h.normal_G.norm(), 1.0, 1e-14);
         Vector3 n_fd;
-        if (test::numerical_normal(shape, h.point, n_fd)) {
-          EXPECT_LT((h.normal - n_fd).norm(), kNormalTolerance);
+        if (test::numerical_normal(shape, h.point_G, n_fd)) {
+          EXPECT_LT((h.normal_G - n_fd).norm(), kNormalTolerance);
           ++checked_normals;
         }
       }
@@ -99,8 +99,8 @@ TEST(RayPrimitives, LinesThroughInteriorPointsEnterBehindAndExitAhead) {
       // The interior point is at λ = 0: entry (pushing) behind it, exit (pulling) ahead.
       EXPECT_LT(hits[0].lambda, 0.0);
       EXPECT_GT(hits[1].lambda, 0.0);
-      EXPECT_LE(hits[0].normal.dot(u), 1e-12);
-      EXPECT_GE(hits[1].normal.dot(u), -1e-12);
+      EXPECT_LE(hits[0].normal_G.dot(u), 1e-12);
+      EXPECT_GE(hits[1].normal_G.dot(u), -1e-12);
     }
   }
 }
@@ -121,7 +121,7 @@ TEST(RayPrimitives, RecoversTheSurfacePointHitFromOutside) {
       const Vector3 o = q + s * u;
       std::array<ShapeHit, 8> hits;
       ASSERT_EQ(intersect_line_with_shape(shape, o, u, hits), 2);
-      EXPECT_LT((hits[0].point - q).norm(), kPointTolerance);
+      EXPECT_LT((hits[0].point_G - q).norm(), kPointTolerance);
       EXPECT_NEAR(hits[0].lambda, -s, kPointTolerance);
       EXPECT_GT(hits[1].lambda, hits[0].lambda);
       ++tested;
@@ -170,9 +170,9 @@ TEST(RayPrimitives, MissesReportTheClosestSurfacePointAsBruteForceSamplingDoes) 
       if (intersect_line_with_shape(shape, o, u, hits) != 0) continue;
       ++misses;
       const ShapeClosestPoint cp = closest_point_to_line(shape, o, u);
-      EXPECT_NEAR(test::implicit(shape, cp.point), 0.0, 1e-12);
+      EXPECT_NEAR(test::implicit(shape, cp.point_G), 0.0, 1e-12);
       // Distance consistent with the returned points, and with brute force.
-      EXPECT_NEAR((o + cp.lambda * u - cp.point).norm(), cp.distance, 1e-12);
+      EXPECT_NEAR((o + cp.lambda * u - cp.point_G).norm(), cp.distance, 1e-12);
       EXPECT_NEAR(cp.distance, sampled_line_distance(shape, o, u), 1e-9);
       EXPECT_GT(cp.distance, 0.0);
     }
@@ -185,12 +185,12 @@ TEST(RayPrimitives, MissDistancesMatchClosedFormsForOffsetLines) {
   // Sphere r = 0.3, line at distance 0.5 from the centre.
   auto cp = closest_point_to_line(test::make_sphere(0.3), Vector3(-1.0, 0.5, 0.0), ux);
   EXPECT_NEAR(cp.distance, 0.2, 1e-15);
-  EXPECT_LT((cp.point - Vector3(0.0, 0.3, 0.0)).norm(), 1e-15);
+  EXPECT_LT((cp.point_G - Vector3(0.0, 0.3, 0.0)).norm(), 1e-15);
   EXPECT_NEAR(cp.lambda, 1.0, 1e-15);
   // Box 0.4 × 0.2 × 0.7, line parallel to x at y = 0.25: 0.15 from the face y = 0.1.
   cp = closest_point_to_line(test::make_box(Vector3(0.4, 0.2, 0.7)), Vector3(3.0, 0.25, 0.1), ux);
   EXPECT_NEAR(cp.distance, 0.15, 1e-12);
-  EXPECT_NEAR(cp.point.y(), 0.1, 1e-12);
+  EXPECT_NEAR(cp.point_G.y(), 0.1, 1e-12);
   // Box, line parallel to z past an edge: distance to the edge (x, y) = (0.2, 0.1).
   cp = closest_point_to_line(test::make_box(Vector3(0.4, 0.2, 0.7)), Vector3(0.5, 0.5, 0.0), uz);
   EXPECT_NEAR(cp.distance, std::hypot(0.3, 0.4), 1e-12);
@@ -213,8 +213,8 @@ TEST(RayPrimitives, TangentLineTouchesTheSphereOnce) {
   const int n = intersect_line_with_shape(test::make_sphere(0.5), Vector3(0.0, 0.5, -3.0),
                                           Vector3::UnitZ(), hits);
   ASSERT_EQ(n, 1);
-  EXPECT_LT((hits[0].point - Vector3(0.0, 0.5, 0.0)).norm(), 1e-15);
-  EXPECT_LT((hits[0].normal - Vector3::UnitY()).norm(), 1e-15);
+  EXPECT_LT((hits[0].point_G - Vector3(0.0, 0.5, 0.0)).norm(), 1e-15);
+  EXPECT_LT((hits[0].normal_G - Vector3::UnitY()).norm(), 1e-15);
 }
 
 TEST(RayPrimitives, LinesParallelToBoxFacesHitTheFacesTheyPoint) {
@@ -227,10 +227,10 @@ TEST(RayPrimitives, LinesParallelToBoxFacesHitTheFacesTheyPoint) {
     std::array<ShapeHit, 4> hits;
     ASSERT_EQ(intersect_line_with_shape(box, o, u, hits), 2);
     const double h = 0.5 * box.size[axis];
-    EXPECT_EQ(hits[0].point[axis], -h);
-    EXPECT_EQ(hits[1].point[axis], h);
-    EXPECT_EQ(hits[0].normal, -u);
-    EXPECT_EQ(hits[1].normal, u);
+    EXPECT_EQ(hits[0].point_G[axis], -h);
+    EXPECT_EQ(hits[1].point_G[axis], h);
+    EXPECT_EQ(hits[0].normal_G, -u);
+    EXPECT_EQ(hits[1].normal_G, u);
     EXPECT_NEAR(hits[0].lambda, 4.0 - h, 1e-15);
     // Same line, shifted outside the box across a parallel face: a miss.
     o[(axis + 1) % 3] = 0.5;
@@ -242,10 +242,10 @@ TEST(RayPrimitives, LinesAlongTheAxisHitCylinderCapsAndCapsulePoles) {
   std::array<ShapeHit, 4> hits;
   const Vector3 o(0.05, -0.02, 3.0), u = -Vector3::UnitZ();
   ASSERT_EQ(intersect_line_with_shape(test::make_cylinder(0.15, 0.6), o, u, hits), 2);
-  EXPECT_EQ(hits[0].point.z(), 0.3);
-  EXPECT_EQ(hits[0].normal, Vector3::UnitZ());
-  EXPECT_EQ(hits[1].point.z(), -0.3);
-  EXPECT_EQ(hits[1].normal, -Vector3::UnitZ());
+  EXPECT_EQ(hits[0].point_G.z(), 0.3);
+  EXPECT_EQ(hits[0].normal_G, Vector3::UnitZ());
+  EXPECT_EQ(hits[1].point_G.z(), -0.3);
+  EXPECT_EQ(hits[1].normal_G, -Vector3::UnitZ());
   // Outside the radius, parallel to the axis: no hit.
   EXPECT_EQ(
       intersect_line_with_shape(test::make_cylinder(0.15, 0.6), Vector3(0.2, 0.0, 0.0), u, hits),
@@ -253,9 +253,9 @@ TEST(RayPrimitives, LinesAlongTheAxisHitCylinderCapsAndCapsulePoles) {
   // Capsule along its axis: the poles at ±(L/2 + r).
   ASSERT_EQ(
       intersect_line_with_shape(test::make_capsule(0.1, 0.5), Vector3(0.0, 0.0, 3.0), u, hits), 2);
-  EXPECT_NEAR(hits[0].point.z(), 0.35, 1e-15);
-  EXPECT_NEAR(hits[1].point.z(), -0.35, 1e-15);
-  EXPECT_LT((hits[0].normal - Vector3::UnitZ()).norm(), 1e-15);
+  EXPECT_NEAR(hits[0].point_G.z(), 0.35, 1e-15);
+  EXPECT_NEAR(hits[1].point_G.z(), -0.35, 1e-15);
+  EXPECT_LT((hits[0].normal_G - Vector3::UnitZ()).norm(), 1e-15);
 }
 
 TEST(RayPrimitives, QueriesDoNotAllocate) {

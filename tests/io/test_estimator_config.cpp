@@ -22,7 +22,7 @@ TEST(EstimatorConfig, ReadsEveryKeyOfAFullFile) {
   const EstimatorOptions& o = c.options;
   EXPECT_EQ(c.robot.model.nq(), 7);
   EXPECT_EQ(o.sensor.type, SensorType::kForceTorque);
-  EXPECT_TRUE(o.sensor.pose.translation.isApprox(Vector3(0, 0, -0.31)));
+  EXPECT_TRUE(o.sensor.X_WS.translation.isApprox(Vector3(0, 0, -0.31)));
   EXPECT_EQ(o.sensor.tare_samples, 20);
   EXPECT_EQ(o.contact.model, ContactModel::kPureForce);
   EXPECT_EQ(o.observer_gain.size(), 7);
@@ -48,10 +48,10 @@ TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {
   const EstimatorConfig c = load_estimator_config(kDir / "minimal_none.yaml");
   const EstimatorOptions d;
   EXPECT_EQ(c.options.sensor.type, SensorType::kNone);
-  // Without sensor.pose: the model's frame 'sensor', 0.31 m below O_0 in models/paper_arm.urdf
-  // (its <joint name="sensor_joint">), as `dynamics` and scenarios take it.
+  // Without sensor.pose in the file: the model's frame 'sensor', 0.31 m below O_0 in
+  // models/paper_arm.urdf (its <joint name="sensor_joint">), as `dynamics` and scenarios take it.
   EXPECT_TRUE(
-      c.options.sensor.pose.is_approx(Pose{Matrix3::Identity(), Vector3(0, 0, -0.31)}, 1e-12));
+      c.options.sensor.X_WS.is_approx(Pose{Matrix3::Identity(), Vector3(0, 0, -0.31)}, 1e-12));
   EXPECT_EQ(c.sensor_pose_source, "the model's frame 'sensor'");
   EXPECT_EQ(c.options.sensor.tare_samples, 0);
   EXPECT_EQ(c.options.contact.model, ContactModel::kPureForce);
@@ -72,7 +72,7 @@ TEST(EstimatorConfig, RobotPathIsRelativeToTheConfigFileAndKnownPointLinksResolv
   EXPECT_EQ(c.options.sensor.tare_samples, 100);  // tare: true
   EXPECT_EQ(c.options.contact.model, ContactModel::kKnownPoint);
   EXPECT_EQ(c.robot.model.bodies[c.options.contact.link].name, "link6");
-  EXPECT_TRUE(c.options.contact.point.isApprox(Vector3(0, 0, 0.1)));
+  EXPECT_TRUE(c.options.contact.point_L.isApprox(Vector3(0, 0, 0.1)));
   EXPECT_EQ(c.options.acceleration, AccelerationRoute::kDifferentiation);
   EXPECT_EQ(c.options.differentiation_cutoff, 40.0);
   ASSERT_TRUE(c.options.friction.has_value());
@@ -93,11 +93,11 @@ TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
     const EstimatorConfig b = load_estimator_config_string(text, kDir / "written.yaml");
     const EstimatorOptions &x = a.options, &y = b.options;
     EXPECT_EQ(x.sensor.type, y.sensor.type) << file;
-    EXPECT_TRUE(x.sensor.pose.is_approx(y.sensor.pose, 1e-15)) << file;
+    EXPECT_TRUE(x.sensor.X_WS.is_approx(y.sensor.X_WS, 1e-15)) << file;
     EXPECT_EQ(x.sensor.tare_samples, y.sensor.tare_samples) << file;
     EXPECT_EQ(x.contact.model, y.contact.model) << file;
     EXPECT_EQ(x.contact.link, y.contact.link) << file;
-    EXPECT_EQ(x.contact.point, y.contact.point) << file;
+    EXPECT_EQ(x.contact.point_L, y.contact.point_L) << file;
     EXPECT_EQ(x.observer_gain.minCoeff(), y.observer_gain.minCoeff()) << file;
     EXPECT_EQ(x.observer_gain.maxCoeff(), y.observer_gain.maxCoeff()) << file;
     EXPECT_EQ(x.detection.f_min, y.detection.f_min) << file;

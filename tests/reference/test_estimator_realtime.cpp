@@ -72,7 +72,7 @@ EstimatorOptions options_for(const Config& c) {
   o.sensor.type = c.sensor;
   o.contact.model = c.contact;
   o.contact.link = 7;
-  o.contact.point = Vector3(0.0, 0.04, 0.03);
+  o.contact.point_L = Vector3(0.0, 0.04, 0.03);
   o.acceleration = c.route;
   o.observer_gain = VectorX::Constant(1, 200.0);
   o.detection.min_duration = 0.0;
@@ -229,7 +229,7 @@ TEST(EstimatorRealTime, TareRemovesAConstantSensorBiasEstimatedAtRest) {
   o.sensor.tare_samples = 50;
   o.contact.model = ContactModel::kKnownPoint;
   o.contact.link = 4;
-  o.contact.point = Vector3(0.06, 0, 0);
+  o.contact.point_L = Vector3(0.06, 0, 0);
   o.detection.min_duration = 0.0;
   const Vector6 bias = (Vector6() << 3.0, -2.0, 40.0, 0.5, -0.7, 0.2).finished();
   // Robot at rest, held by τ = g(q) (so the residual stays zero), then touched.
@@ -251,7 +251,7 @@ TEST(EstimatorRealTime, TareRemovesAConstantSensorBiasEstimatedAtRest) {
   // A static contact balanced by the controller: the base sees it instantly.
   const Pose X = kdl.compute_body_pose(q, 4);
   const Vector3 F(8, 3, -6), M(0.3, 0.1, -0.2);
-  const auto touched = kdl.compute(q, zero, zero, 4, F, X.act(o.contact.point), M);
+  const auto touched = kdl.compute(q, zero, zero, 4, F, X.act(o.contact.point_L), M);
   ASSERT_TRUE(
       est.update(0.051, q, zero, free.tau, test::to_sensor_frame(touched.reading_W, Pose{}) + bias)
           .ok());
@@ -384,7 +384,7 @@ TEST(EstimatorRealTime, UpdateFromASampleServesEverySensorTypeBitForBitWithoutAl
       sample.q = s.q[k];
       sample.dq = s.dq[k];
       sample.tau = s.tau[k];
-      sample.sensor = s.reading[k];
+      sample.reading_S = s.reading[k];
       if (c.sensor != SensorType::kNone && k % 7 == 0) {
         // A sample without the reading the sensor needs: rejected, nothing changed.
         sample.has_force = c.sensor == SensorType::kForceTorque;

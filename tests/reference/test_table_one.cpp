@@ -79,7 +79,7 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
   for (int link = first_link; link <= n; ++link) {
     EstimatorOptions opt;
     opt.sensor.type = c.sensor;
-    opt.sensor.pose =
+    opt.sensor.X_WS =
         Pose::from_xyz_rpy(rng.uniform_vector3(-0.2, 0.2), rng.uniform_vector3(-1, 1));
     opt.contact.model = c.contact;
     opt.contact.link = link;
@@ -113,12 +113,12 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
       const Vector3 M =
           c.contact == ContactModel::kKnownPoint ? rng.uniform_vector3(-2, 2) : Vector3::Zero();
       const test::KdlReference::Result ref = kdl.compute(q, dq, ddq, link, F, p_W, M);
-      const Vector6 reading_S = test::to_sensor_frame(ref.reading_W, opt.sensor.pose);
+      const Vector6 reading_S = test::to_sensor_frame(ref.reading_W, opt.sensor.X_WS);
 
       // Re-target the known point of this sample (the estimator's point is a configuration).
       if (c.contact == ContactModel::kKnownPoint) {
         EstimatorOptions o2 = opt;
-        o2.contact.point = p_L;
+        o2.contact.point_L = p_L;
         ContactEstimator est2(model, robot.geometry, o2);
         ASSERT_TRUE(est2.update_with(t, q, dq, ddq, ref.tau_ext, ref.tau, reading_S).ok());
         const ContactEstimate& e = est2.result();
@@ -221,7 +221,7 @@ TEST(TableOneObservability, ForceSensorMomentOnLinkThreeDependsOnTheRankNotTheIn
   opt.sensor.type = SensorType::kForce;
   opt.contact.model = ContactModel::kKnownPoint;
   opt.contact.link = 3;
-  opt.contact.point = Vector3(0.06, 0, 0.2);
+  opt.contact.point_L = Vector3(0.06, 0, 0.2);
   opt.detection.tau_min = VectorX::Constant(1, 1e-9);
   opt.detection.f_min = 1e-9;
   opt.detection.min_duration = 0.0;
@@ -231,7 +231,7 @@ TEST(TableOneObservability, ForceSensorMomentOnLinkThreeDependsOnTheRankNotTheIn
     q << 0.3, q2, -0.4, 1.0, 0.2, 0.5, 0.1;
     const VectorX dq = VectorX::Zero(7), ddq = VectorX::Zero(7);
     const Pose X = kdl.compute_body_pose(q, 3);
-    const auto ref = kdl.compute(q, dq, ddq, 3, Vector3(3, -4, 5), X.act(opt.contact.point),
+    const auto ref = kdl.compute(q, dq, ddq, 3, Vector3(3, -4, 5), X.act(opt.contact.point_L),
                                  Vector3(0.5, 0.2, -0.3));
     ASSERT_TRUE(est.update_with(0.0, q, dq, ddq, ref.tau_ext, ref.tau,
                                 test::to_sensor_frame(ref.reading_W, Pose{}))

@@ -57,7 +57,7 @@ TEST(Rk4, EnergyChangeEqualsTheWorkOfTorquesAndExternalForces) {
   forces[0].axes = ForceProfile::Axes::kWorld;
   forces[0].force = Vector3(3.0, -2.0, 5.0);
   forces[0].moment = Vector3(0.2, 0.1, -0.3);
-  forces[0].point = Vector3(0.05, 0.0, 0.1);
+  forces[0].point_F = Vector3(0.05, 0.0, 0.1);
   forces[0].resolve(model);
   Rk4Workspace ws(model);
   Data data(model);
@@ -110,7 +110,7 @@ TEST(Simulator, TrueAccelerationSatisfiesInverseDynamicsWithTheExternalWrench) {
   std::vector<ForceProfile> forces(2);
   forces[0].frame = "link6";
   forces[0].force = Vector3(20, 0, 0);
-  forces[0].point = Vector3(0, 0, 0.1);
+  forces[0].point_F = Vector3(0, 0, 0.1);
   forces[1].frame = "link3";
   forces[1].axes = ForceProfile::Axes::kWorld;
   forces[1].force = Vector3(0, -4, 1);
@@ -157,7 +157,7 @@ TEST(ForceProfile, FrameForceTurnsWithTheLinkAndWorldForceDoesNot) {
   ForceProfile in_frame;
   in_frame.frame = "link2";
   in_frame.force = Vector3(1, 2, 3);
-  in_frame.point = Vector3(0.1, 0.2, 0.3);
+  in_frame.point_F = Vector3(0.1, 0.2, 0.3);
   in_frame.resolve(model);
   ForceProfile in_world = in_frame;
   in_world.axes = ForceProfile::Axes::kWorld;
@@ -205,14 +205,14 @@ TEST(SensorModel, DifferentiatedVelocityOfARampIsItsSlope) {
 
 TEST(SensorModel, NoiseHasTheConfiguredBiasAndStandardDeviation) {
   BaseSensorModel s;
-  s.bias << 1, 2, 3, 0.1, 0.2, 0.3;
-  s.force_noise = Vector3(0.5, 0.5, 0.5);
-  s.moment_noise = Vector3(0.05, 0.05, 0.05);
+  s.bias_S << 1, 2, 3, 0.1, 0.2, 0.3;
+  s.force_noise_S = Vector3(0.5, 0.5, 0.5);
+  s.moment_noise_S = Vector3(0.05, 0.05, 0.05);
   Rng rng(7);
   const int kDraws = 40000;
   Vector6 sum = Vector6::Zero(), sum_sq = Vector6::Zero();
   for (int k = 0; k < kDraws; ++k) {
-    const Vector6 r = s.measure(Vector6::Zero(), rng) - s.bias;
+    const Vector6 r = s.measure(Vector6::Zero(), rng) - s.bias_S;
     sum += r;
     sum_sq += r.cwiseProduct(r);
   }
@@ -271,7 +271,7 @@ TEST(Controller, IntegralTermRecoversThePathUnderAConstantForce) {
   cfg.forces[0].frame = "link6";
   cfg.forces[0].axes = ForceProfile::Axes::kWorld;
   cfg.forces[0].force = Vector3(20, 0, 0);
-  cfg.forces[0].point = Vector3(0, 0, 0.1);
+  cfg.forces[0].point_F = Vector3(0, 0, 0.1);
   cfg.forces[0].start = 0.5;
   Simulator sim(model, ctl, cfg);
   Sample s;
@@ -283,7 +283,7 @@ TEST(Controller, IntegralTermRecoversThePathUnderAConstantForce) {
     peak = std::max(peak, last);
     if (s.t >= 0.5) {
       EXPECT_EQ(s.truth.link, "link6");
-      EXPECT_NEAR(s.truth.force.norm(), 20.0, 1e-9);
+      EXPECT_NEAR(s.truth.force_W.norm(), 20.0, 1e-9);
     } else {
       EXPECT_EQ(s.truth.link, "");
     }
@@ -311,7 +311,7 @@ TEST(Simulator, BaseReadingEqualsWeightPlusForceForARobotHeldAtRest) {
   Sample s;
   while (sim.next(s)) {
     const Vector3 expected = model.total_mass() * model.gravity + Vector3(1, -2, 30);
-    EXPECT_LT((s.sensor.head<3>() - expected).norm(), 1e-8);
+    EXPECT_LT((s.reading_S.head<3>() - expected).norm(), 1e-8);
     EXPECT_LT(s.truth.tau_ext.norm(), 1e-12);  // Remark: a contact on link 0 has no residual
   }
 }
@@ -321,8 +321,8 @@ TEST(Metrics, AccumulatesErrorsInsideTheWindowOnly) {
   Truth truth;
   truth.body = 4;
   truth.contacts = 1;
-  truth.force = Vector3(10, 0, 0);
-  truth.point = Vector3(0, 0, 1);
+  truth.force_W = Vector3(10, 0, 0);
+  truth.point_W = Vector3(0, 0, 1);
   ContactEstimate est;
   est.contact = true;
   est.link = 4;
@@ -352,7 +352,7 @@ TEST(Metrics, CountsFalseAlarmsMissesAndDetectionDelay) {
   Truth contact;
   contact.body = 2;
   contact.contacts = 1;
-  contact.force = Vector3(0, 0, 3);
+  contact.force_W = Vector3(0, 0, 3);
   ContactEstimate none, alarm;
   alarm.contact = true;
   alarm.link = 2;

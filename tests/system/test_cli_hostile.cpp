@@ -236,7 +236,7 @@ void write_log(const fs::path& path, long rows) {
   s.q = VectorX::Constant(7, 0.1);
   s.dq = VectorX::Zero(7);
   s.tau = VectorX::Constant(7, 1.0);
-  s.sensor << 1, 2, -170, 0.1, 0.2, 0.3;
+  s.reading_S << 1, 2, -170, 0.1, 0.2, 0.3;
   for (long k = 0; k < rows; ++k) {
     s.t = 0.001 * static_cast<double>(k);
     w.write(s);

@@ -98,7 +98,7 @@ void run(const Scenario& s, Visit&& visit) {
   opt.sensor.type = s.sensor;
   opt.contact.model = s.contact;
   opt.contact.link = s.link;
-  opt.contact.point = s.p_L;
+  opt.contact.point_L = s.p_L;
   opt.observer_gain = VectorX::Constant(1, s.gain);
   opt.acceleration = s.route;
   opt.detection.tau_min = VectorX::Constant(1, s.tau_min);

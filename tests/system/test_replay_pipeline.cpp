@@ -85,13 +85,13 @@ void write_log(const fs::path& path, long rows, bool velocity) {
     }
     s.t = t;
     const bool push = k >= 300;
-    s.sensor << rng.uniform(-1, 1) + (push ? 15.0 : 0.0), rng.uniform(-1, 1),
+    s.reading_S << rng.uniform(-1, 1) + (push ? 15.0 : 0.0), rng.uniform(-1, 1),
         -170 + rng.uniform(-1, 1), rng.uniform(-0.1, 0.1),
         rng.uniform(-0.1, 0.1) + (push ? 6.0 : 0.0), rng.uniform(-0.1, 0.1);
     s.truth.link = push ? "link6" : "";
     s.truth.body = push ? 6 : -1;
-    s.truth.force << (push ? 15.0 : 0.0), 0, 0;
-    s.truth.point << 0.1, 0.0, 0.6;
+    s.truth.force_W << (push ? 15.0 : 0.0), 0, 0;
+    s.truth.point_W << 0.1, 0.0, 0.6;
     w.write(s);
   }
   w.close();
@@ -150,7 +150,7 @@ Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& option
       } else {
         (void)(options.sensor.type == SensorType::kNone
                    ? estimator.update(s.t, s.q, s.dq, s.tau)
-                   : estimator.update(s.t, s.q, s.dq, s.tau, s.sensor));
+                   : estimator.update(s.t, s.q, s.dq, s.tau, s.reading_S));
         writer.write(estimator.result());
       }
     }

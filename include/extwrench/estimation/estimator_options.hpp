@@ -16,7 +16,7 @@ namespace extwrench {
 
 struct SensorOptions {
   SensorType type = SensorType::kNone;
-  Pose pose;  ///< X_WS: pose of the sensor frame in the robot's root frame
+  Pose X_WS;  ///< pose of the sensor frame in the robot's root frame
   int tare_samples =
       0;  ///< > 0: bias = mean(reading − predicted) over the first samples after reset
   Vector6 bias_S = Vector6::Zero();  ///< bias [f; n] in S at the start (calibration); a tare
@@ -25,8 +25,8 @@ struct SensorOptions {
 
 struct ContactOptions {
   ContactModel model = ContactModel::kPureForce;
-  int link = -1;                    ///< known point: body index of the contact link
-  Vector3 point = Vector3::Zero();  ///< known point: p in the link frame [m]
+  int link = -1;                      ///< known point: body index of the contact link
+  Vector3 point_L = Vector3::Zero();  ///< known point: p in the link frame L [m]
 };
 
 struct PayloadOptions {

@@ -17,40 +17,41 @@
 
 namespace extwrench {
 
-/// One intersection of a line with the surface of a shape, in the shape frame S.
+/// One intersection of a line with the surface of a shape, in the shape frame G.
 struct ShapeHit {
-  double lambda = 0.0;               ///< λ [m] along the unit direction
-  Vector3 point = Vector3::Zero();   ///< p_S: the surface point p(λ)
-  Vector3 normal = Vector3::Zero();  ///< outward unit normal (meshes: from the triangle's winding)
+  double lambda = 0.0;                ///< λ [m] along the unit direction
+  Vector3 point_G = Vector3::Zero();  ///< p_G: the surface point p(λ)
+  Vector3 normal_G =
+      Vector3::Zero();  ///< outward unit normal (meshes: from the triangle's winding)
 };
 
-/// The surface point of a shape nearest to a line, in the shape frame S.
+/// The surface point of a shape nearest to a line, in the shape frame G.
 struct ShapeClosestPoint {
-  Vector3 point = Vector3::Zero();  ///< on the surface
-  double lambda = 0.0;              ///< λ of the line point nearest to `point`
-  double distance = 0.0;            ///< [m] ≥ 0; 0 when the line meets the surface
+  Vector3 point_G = Vector3::Zero();  ///< on the surface
+  double lambda = 0.0;                ///< λ of the line point nearest to `point_G`
+  double distance = 0.0;              ///< [m] ≥ 0; 0 when the line meets the surface
 };
 
-/// All intersections of the line origin_S + λ direction_S (direction_S a unit vector, both in
+/// All intersections of the line origin_G + λ direction_G (direction_G a unit vector, both in
 /// the shape frame) with the surface of `shape`, sorted by increasing λ; coincident hits (a mesh
 /// edge shared by two triangles) are merged. A convex primitive gives 0 or 2 hits (1 for a tangent
 /// line). Writes at most hits.size() hits (the smallest λ first) and returns
 /// how many it wrote. A mesh shape without a mesh gives 0.
 /// Meshes use mesh->ray_caster when present (candidates refined in double precision against
 /// each triangle), else a double-precision loop over all triangles.
-[[nodiscard]] int intersect_line_with_shape(const CollisionShape& shape, const Vector3& origin_S,
-                                            const Vector3& direction_S,
+[[nodiscard]] int intersect_line_with_shape(const CollisionShape& shape, const Vector3& origin_G,
+                                            const Vector3& direction_G,
                                             std::span<ShapeHit> hits) noexcept;
 
-/// The surface point of `shape` nearest to the line origin_S + λ direction_S (unit direction,
+/// The surface point of `shape` nearest to the line origin_G + λ direction_G (unit direction,
 /// shape frame). If the line meets the surface: its first (smallest λ) hit, distance 0.
 /// Spheres and capsules in closed form; boxes and cylinders by a bounded golden-section search
 /// of the convex line-to-solid distance (64 iterations); meshes exactly, from
 /// the triangle edges (for a line that misses a triangle, the nearest point of the triangle is
 /// on an edge). A mesh shape without a mesh gives distance = +inf.
 [[nodiscard]] ShapeClosestPoint closest_point_to_line(const CollisionShape& shape,
-                                                      const Vector3& origin_S,
-                                                      const Vector3& direction_S) noexcept;
+                                                      const Vector3& origin_G,
+                                                      const Vector3& direction_G) noexcept;
 
 /// One intersection of the line with a body's surface, in the world frame W.
 struct LineHit {

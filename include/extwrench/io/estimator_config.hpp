@@ -41,7 +41,7 @@ struct EstimatorConfig {
   /// Joints locked when loading it (the file's locked_joints and LoadOptions'), for to_yaml.
   std::map<std::string, double> locked_joints;
   EstimatorOptions options;  ///< link names resolved to body indices, sizes checked
-  /// Where options.sensor.pose came from: "sensor.pose" when the file gives it, else the rule
+  /// Where options.sensor.X_WS came from: "sensor.pose" when the file gives it, else the rule
   /// of default_sensor_pose() in words (printed at the start of a replay).
   std::string sensor_pose_source;
 };

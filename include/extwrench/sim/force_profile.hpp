@@ -21,12 +21,12 @@ namespace extwrench::sim {
 struct ForceProfile {
   enum class Axes { kFrame, kWorld };
 
-  std::string frame;                 ///< name of a Model frame (resolved by resolve())
-  Axes axes = Axes::kFrame;          ///< axes in which force / moment are constant
-  Vector3 force = Vector3::Zero();   ///< [N]
-  Vector3 moment = Vector3::Zero();  ///< pure moment [N m]
-  Vector3 point = Vector3::Zero();   ///< application point in `frame` [m]
-  double start = 0.0;                ///< [s]
+  std::string frame;                  ///< name of a Model frame (resolved by resolve())
+  Axes axes = Axes::kFrame;           ///< axes in which force / moment are constant
+  Vector3 force = Vector3::Zero();    ///< [N]
+  Vector3 moment = Vector3::Zero();   ///< pure moment [N m]
+  Vector3 point_F = Vector3::Zero();  ///< application point in `frame` F [m]
+  double start = 0.0;                 ///< [s]
   double end = std::numeric_limits<double>::infinity();  ///< [s]
   double ramp = 0.0;                                     ///< [s]
 

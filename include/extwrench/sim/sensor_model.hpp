@@ -14,10 +14,10 @@ namespace extwrench::sim {
 /// noise per axis.
 struct BaseSensorModel {
   SensorType type = SensorType::kForceTorque;
-  Pose X_WS;                               ///< pose of the sensor frame in the robot's root frame W
-  Vector6 bias = Vector6::Zero();          ///< [N; N m] added to every reading
-  Vector3 force_noise = Vector3::Zero();   ///< standard deviation per axis [N]
-  Vector3 moment_noise = Vector3::Zero();  ///< standard deviation per axis [N m]
+  Pose X_WS;                         ///< pose of the sensor frame in the robot's root frame W
+  Vector6 bias_S = Vector6::Zero();  ///< [N; N m] added to every reading
+  Vector3 force_noise_S = Vector3::Zero();   ///< standard deviation per axis [N]
+  Vector3 moment_noise_S = Vector3::Zero();  ///< standard deviation per axis [N m]
 
   /// Ideal reading + bias + noise. Noise is drawn for all six axes every call (whatever the
   /// type), so the stream does not depend on the sensor type.
