@@ -46,7 +46,8 @@ CandidateHit test_candidate(const Model& model, const Data& data, const Geometry
   Vector3 p_W, u_W;
   if (!line_of_action(fit, O_l, p_W, u_W)) return out;
   consistent = true;
-  const SurfacePointResult res = intersect_line_with_body(geometry, l, X_WL, p_W, u_W);
+  const SurfacePointResult res =
+      intersect_line_with_body(geometry, l, X_WL, p_W, u_W, OnMiss::kNothing);
   if (res.hit) {
     out.hit = true;
     out.abscissa = u_W.dot(res.entry.point_W);

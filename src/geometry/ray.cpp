@@ -67,7 +67,7 @@ ShapeClosestPoint closest_point_to_line(const CollisionShape& shape, const Vecto
 
 SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int body,
                                             const Pose& X_WB, const Vector3& point_on_line_W,
-                                            const Vector3& direction_W) noexcept {
+                                            const Vector3& direction_W, OnMiss on_miss) noexcept {
   SurfacePointResult result;
   const LineHit none{kNaN, Vector3::Constant(kNaN), Vector3::Constant(kNaN), -1};
   result.entry = none;
@@ -125,6 +125,7 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
     result.shape = result.entry.shape;
     return result;
   }
+  if (on_miss == OnMiss::kNothing) return result;
   for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
     if (s < 0 || s >= num_shapes) continue;
     const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];

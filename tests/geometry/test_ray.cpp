@@ -132,6 +132,37 @@ TEST(RayBody, MissReportsTheNearestShapeAndItsClosestPoint) {
   EXPECT_EQ(r.entry.shape, -1);
 }
 
+TEST(RayBody, HitOnlyQueryAgreesOnHitsAndSkipsTheNearestPointOnMisses) {
+  const GeometryModel g = two_shape_model();
+  SeededRng rng(33);
+  int hits = 0, misses = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Pose X_WB = random_pose(rng);
+    const Vector3 p_W = X_WB.act(rng.uniform_vector3(-0.8, 0.8));
+    const Vector3 u_W = random_unit(rng);
+    const SurfacePointResult full = intersect_line_with_body(g, 1, X_WB, p_W, u_W);
+    const SurfacePointResult only =
+        intersect_line_with_body(g, 1, X_WB, p_W, u_W, OnMiss::kNothing);
+    ASSERT_EQ(only.hit, full.hit);
+    if (full.hit) {
+      ++hits;
+      EXPECT_EQ(only.num_hits, full.num_hits);
+      EXPECT_EQ(only.entry.point_W, full.entry.point_W);
+      EXPECT_EQ(only.exit.point_W, full.exit.point_W);
+      EXPECT_EQ(only.entry.shape, full.entry.shape);
+      EXPECT_EQ(only.distance, 0.0);
+    } else {
+      ++misses;
+      EXPECT_TRUE(std::isfinite(full.distance));
+      EXPECT_EQ(only.distance, std::numeric_limits<double>::infinity());
+      EXPECT_TRUE(std::isnan(only.closest_point_W.x()));
+      EXPECT_EQ(only.shape, -1);
+    }
+  }
+  EXPECT_GT(hits, 40);
+  EXPECT_GT(misses, 40);
+}
+
 TEST(RayBody, DegenerateInputsGiveNoHit) {
   const GeometryModel g = two_shape_model();
   const Pose X = Pose::identity();

@@ -78,16 +78,22 @@ struct SurfacePointResult {
   int shape = -1;  ///< shape of closest_point_W
 };
 
+/// What intersect_line_with_body computes when the line misses every shape of the body.
+enum class OnMiss {
+  kNearestPoint,  ///< the surface point nearest to the line (a search over every triangle)
+  kNothing,       ///< only hit/miss: distance +inf, closest point NaN (isolation's query)
+};
+
 /// Intersects the line p(λ) = point_on_line_W + λ direction_W/‖direction_W‖ (21) with every
 /// collision shape of `body` (posed at X_WB = pose of the body in W; each shape at
 /// X_WB · placement) and returns the smallest-λ hit (pushing point) and the largest-λ hit
-/// (pulling point) over all of them, or, if the line misses them all, the nearest surface point.
+/// (pulling point) over all of them, or, if the line misses them all, the nearest surface point
+/// (unless `on_miss` is OnMiss::kNothing).
 /// Mesh entry/exit normals are oriented against/along u (correct for closed meshes whatever
 /// their winding). A zero or non-finite direction, or a body index outside body_shapes, gives
 /// hit = false. Real-time safe: noexcept, no allocation, bounded time.
-[[nodiscard]] SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int body,
-                                                          const Pose& X_WB,
-                                                          const Vector3& point_on_line_W,
-                                                          const Vector3& direction_W) noexcept;
+[[nodiscard]] SurfacePointResult intersect_line_with_body(
+    const GeometryModel& geometry, int body, const Pose& X_WB, const Vector3& point_on_line_W,
+    const Vector3& direction_W, OnMiss on_miss = OnMiss::kNearestPoint) noexcept;
 
 }  // namespace extwrench
