@@ -19,16 +19,16 @@ constexpr double kForceOff = 0.5;  // [s] when the sensor says the force is gone
 /// What the detector sees over 1 s: a push from 0.1 s of residual `level` × τ_min on joint 2
 /// and base force `level` × F_min. The sensor's instantaneous force drops to 0 at kForceOff;
 /// the residual and the lagged base force decay from then on only if `force_ends`.
-struct Run {
+struct ReleaseRun {
   int declared_after_off = 0;  ///< samples with a declared contact after kForceOff + 20 ms
   int onsets = 0;              ///< rising edges of the declared contact
   double released_at = NAN;    ///< first release after kForceOff [s]
 };
 
-Run run(double level, bool force_ends) {
+ReleaseRun run_detector(double level, bool force_ends) {
   DetectionOptions options;  // τ_min 1, F_min 5, ratio 0.5, min_duration 5 ms
   ContactDetector detector(options, kJoints, kSettle);
-  Run out;
+  ReleaseRun out;
   bool was = false;
   for (int k = 0; k <= 1000; ++k) {
     const double t = k * kDt;
@@ -49,7 +49,7 @@ Run run(double level, bool force_ends) {
 
 TEST(Detection, ASensorReleaseTheResidualConfirmsStaysReleased) {
   for (const double level : {3.0, 20.0, 200.0}) {  // 200: still over its threshold at 5 τ
-    const Run r = run(level, true);
+    const ReleaseRun r = run_detector(level, true);
     EXPECT_EQ(r.onsets, 1) << level;
     EXPECT_NEAR(r.released_at, kForceOff + 0.005, 1.5e-3) << level;  // min_duration
     EXPECT_EQ(r.declared_after_off, 0) << level;
@@ -60,7 +60,7 @@ TEST(Detection, ASensorReleaseTheResidualContradictsIsUndoneOnce) {
   // The sensor's force fell to 0 but the residual stays: the force is on another link than
   // the one the release assumed. The contact is declared again after the settle time and then
   // held (no release/onset cycles) while the residual lasts.
-  const Run r = run(10.0, false);
+  const ReleaseRun r = run_detector(10.0, false);
   EXPECT_EQ(r.onsets, 2);
   EXPECT_NEAR(r.released_at, kForceOff + 0.005, 1.5e-3);
   const int samples_after = 1000 - static_cast<int>((kForceOff + 0.02) / kDt);
