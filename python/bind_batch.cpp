@@ -67,6 +67,7 @@ struct BatchOutput {
   py::array_t<bool> contact;
   py::array_t<std::int32_t> link, status;
   py::array_t<std::uint32_t> flags;
+  py::array_t<std::uint64_t> link_candidates;
   std::vector<std::string> status_names;
 
   BatchOutput(py::ssize_t rows, int n)
@@ -83,7 +84,8 @@ struct BatchOutput {
         contact(rows),
         link(rows),
         status(rows),
-        flags(rows) {}
+        flags(rows),
+        link_candidates(rows) {}
 };
 
 struct RowWriter {
@@ -92,6 +94,7 @@ struct RowWriter {
   bool* contact;
   std::int32_t *link, *status;
   std::uint32_t* flags;
+  std::uint64_t* link_candidates;
   int n;
   int bodies;
   std::vector<std::string>* status_names;
@@ -114,6 +117,7 @@ struct RowWriter {
         link(o.link.mutable_data()),
         status(o.status.mutable_data()),
         flags(o.flags.mutable_data()),
+        link_candidates(o.link_candidates.mutable_data()),
         n(n_),
         bodies(bodies_),
         status_names(&o.status_names) {}
@@ -152,6 +156,7 @@ struct RowWriter {
     surface[k] = e.surface_distance;
     cond[k] = e.condition_number;
     flags[k] = e.flags;
+    link_candidates[k] = e.link_candidates;
     status[k] = status_of(e);
     double* r = residual + k * static_cast<std::size_t>(n);
     for (int i = 0; i < n; ++i) r[i] = e.residual.size() == n ? e.residual[i] : std::nan("");
@@ -228,6 +233,7 @@ py::dict estimate_batch(const Estimator& source, const py::handle& t, const py::
   d["line_direction_W"] = out.line_direction;
   d["surface_distance"] = out.surface;
   d["flags"] = out.flags;
+  d["link_candidates"] = out.link_candidates;
   return d;
 }
 

@@ -165,6 +165,17 @@ void bind_estimate(py::module_& m) {
           },
           "Name of the contact link, None if none.")
       .def_property_readonly(
+          "link_candidates",
+          [](const Estimate& e) {
+            std::vector<int> out;
+            for (int l = 0; l < 64; ++l) {
+              if ((e.value.link_candidates >> l & 1u) != 0) out.push_back(l);
+            }
+            return out;
+          },
+          "Geometry isolation: the other links (body indices) consistent with the residual and "
+          "the line of action; empty when none.")
+      .def_property_readonly(
           "force_W", [](const Estimate& e) { return e.value.force_W; }, "(3,) F_ext [N].")
       .def_property_readonly(
           "moment_W", [](const Estimate& e) { return e.value.moment_W; },

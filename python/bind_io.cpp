@@ -126,6 +126,8 @@ struct EstimateRows {
   RealArray t, contact, link, force, moment, point, line_point, line_direction, cond, residual,
       flags;
   std::vector<std::string> status;
+  /// Bit l: body l (the estimates.csv column link_candidates); absent in older dicts.
+  py::array_t<std::uint64_t> link_candidates;
   py::ssize_t rows = 0;
   int n = 0;
 
@@ -142,6 +144,15 @@ struct EstimateRows {
     cond = column(d, "estimates", "cond", rows, -1);
     residual = column(d, "estimates", "residual", rows, n);
     flags = column(d, "estimates", "flags", rows, -1);
+    if (d.contains("link_candidates")) {
+      link_candidates =
+          py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(
+              d["link_candidates"]);
+      if (!link_candidates || link_candidates.ndim() != 1 || link_candidates.shape(0) != rows) {
+        throw py::value_error("estimates['link_candidates']: expected " + std::to_string(rows) +
+                              " unsigned integers (bit l: body l)");
+      }
+    }
     if (d.contains("status")) status = d["status"].cast<std::vector<std::string>>();
     if (!status.empty() && static_cast<py::ssize_t>(status.size()) != rows) {
       throw py::value_error("estimates['status']: expected " + std::to_string(rows) + " entries");
@@ -161,6 +172,7 @@ struct EstimateRows {
     e.residual.resize(n);
     for (int i = 0; i < n; ++i) e.residual[i] = residual.at(k, i);
     e.flags = static_cast<std::uint32_t>(flags.at(k));
+    e.link_candidates = link_candidates ? link_candidates.at(k) : 0;
     e.status = status.empty() ? Status{} : parse_status(status[static_cast<std::size_t>(k)]);
   }
 };

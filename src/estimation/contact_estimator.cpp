@@ -23,6 +23,14 @@ constexpr double kTimeSlack = 1e-9;  // [s]
 // A residual / filter transient is over after this many time constants (e^{-5} < 1 %).
 constexpr double kSettleTimeConstants = 5.0;
 
+/// How long the residual (or the differentiation filter) takes to forget a force that ended.
+double settle_time_of(const EstimatorOptions& options, const MomentumObserver& observer) {
+  const double slowest = options.acceleration == AccelerationRoute::kResidual
+                             ? 1.0 / observer.gains().minCoeff()
+                             : 1.0 / (2.0 * std::numbers::pi * options.differentiation_cutoff);
+  return std::max(kSettleTimeConstants * slowest, options.detection.min_duration);
+}
+
 }  // namespace
 
 ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, EstimatorOptions options)
@@ -31,7 +39,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
       data_(model_),
       geometry_(std::move(geometry)),
       observer_(model_, options_.observer_gain),
-      detector_(options_.detection, model_.nq()),
+      detector_(options_.detection, model_.nq(), settle_time_of(options_, observer_)),
       isolation_ws_(model_),
       n_(model_.nq()),
       differentiation_(options_.acceleration == AccelerationRoute::kDifferentiation),
@@ -49,10 +57,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   if (options_.friction) observer_.set_friction(*options_.friction);
   tare_.bias_S = options_.sensor.bias_S;  // a calibrated bias (zero by default)
   if (options_.payload) apply_payload(options_.payload->body, &options_.payload->inertia);
-  const double slowest = options_.acceleration == AccelerationRoute::kResidual
-                             ? 1.0 / observer_.gains().minCoeff()
-                             : 1.0 / (2.0 * std::numbers::pi * options_.differentiation_cutoff);
-  settle_time_ = std::max(kSettleTimeConstants * slowest, options_.detection.min_duration);
+  settle_time_ = settle_time_of(options_, observer_);
   dq_prev_ = VectorX::Zero(n_);
   ddq_filtered_ = VectorX::Zero(n_);
   ddq_ = VectorX::Constant(n_, kNaN);

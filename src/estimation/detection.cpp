@@ -1,5 +1,6 @@
 #include "extwrench/estimation/detection.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -34,7 +35,8 @@ void validate(const DetectionOptions& options, int n) {
   }
 }
 
-ContactDetector::ContactDetector(const DetectionOptions& options, int n) : options_(options) {
+ContactDetector::ContactDetector(const DetectionOptions& options, int n, double release_settle_time)
+    : options_(options), release_settle_time_(release_settle_time) {
   validate(options, n);
   const VectorX& t = options.tau_min;
   tau_min_ = t.size() == 1 ? VectorX::Constant(n, t[0]) : t;
@@ -48,6 +50,9 @@ void ContactDetector::reset() noexcept {
   have_edge_ = false;
   last_link_ = -1;
   rearm_ = false;
+  release_time_ = 0.0;
+  release_level_ = 0.0;
+  sensor_release_disproved_ = false;
   result_ = DetectionResult{};
 }
 
@@ -72,16 +77,23 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
   if (base_only) link = 0;  // a contact no joint feels is on link 0 (Sec. II-B)
   bool raw = link >= 0;
   const bool over = raw;
+  if (!over) sensor_release_disproved_ = false;
   // The sensor says the force is gone: release without waiting for the residual's decay.
-  if (declared_ && std::isfinite(release_force_norm) &&
+  if (declared_ && !sensor_release_disproved_ && std::isfinite(release_force_norm) &&
       !(release_force_norm > ratio * options_.f_min)) {
     raw = false;
   }
   if (rearm_) {  // after a sensor release, a new onset needs every threshold to have dropped
-    if (over)
-      raw = false;
-    else
+    if (!over) {
       rearm_ = false;
+    } else if (t - release_time_ > release_settle_time_ &&
+               level(tau_ext, base_force_norm) > 0.5 * release_level_) {
+      // The residual has had time to decay and has not: the force is still there.
+      rearm_ = false;
+      sensor_release_disproved_ = true;
+    } else {
+      raw = false;
+    }
   }
 
   // Debounce both edges: the raw state must hold for min_duration before it is declared.
@@ -93,7 +105,11 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
     if (t - edge_time_ >= options_.min_duration - kTimeSlack) {
       declared_ = raw;
       have_edge_ = false;
-      if (!raw && over) rearm_ = true;
+      if (!raw && over) {
+        rearm_ = true;
+        release_time_ = t;
+        release_level_ = level(tau_ext, base_force_norm);
+      }
     }
   } else {
     have_edge_ = false;
@@ -106,6 +122,14 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
   result_.base_only = base_only;
   result_.link = declared_ ? last_link_ : -1;
   return result_;
+}
+
+double ContactDetector::level(const Eigen::Ref<const VectorX>& tau_ext,
+                              double base_force_norm) const noexcept {
+  double out = std::isfinite(base_force_norm) ? base_force_norm / options_.f_min : 0.0;
+  for (Eigen::Index i = 0; i < tau_min_.size(); ++i)
+    out = std::max(out, std::abs(tau_ext[i]) / tau_min_[i]);
+  return out;
 }
 
 }  // namespace extwrench

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "builder_messages.hpp"
 #include "extwrench/core/error.hpp"
 
 namespace extwrench {
@@ -21,18 +22,9 @@ constexpr double kInertiaRelTol = 1e-8;
 // Pivot of M(0) (articulated-body inertia along a joint's axis) relative to the joint's
 // diagonal entry (composite inertia) below which M(0) counts as singular.
 constexpr double kMassMatrixRelTol = 1e-12;
-// |axis| below this is a zero axis.
-constexpr double kMinAxisNorm = 1e-12;
-
-std::string num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
-std::string prefix(const std::string& source) {
-  return source.empty() ? std::string() : source + ": ";
-}
+using model_detail::kMinAxisNorm;
+using model_detail::num;
+using model_detail::prefix;
 
 bool finite(const Pose& x) { return x.rotation.allFinite() && x.translation.allFinite(); }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "builder_messages.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/model/model_builder.hpp"
 
@@ -12,17 +13,9 @@ namespace extwrench {
 
 namespace {
 
-constexpr double kMinAxisNorm = 1e-12;  // as the builder's own check
-
-std::string num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
-std::string prefix(const std::string& source) {
-  return source.empty() ? std::string() : source + ": ";
-}
+using model_detail::kMinAxisNorm;
+using model_detail::num;
+using model_detail::prefix;
 
 }  // namespace
 

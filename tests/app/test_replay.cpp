@@ -24,11 +24,14 @@
 #include "extwrench/io/urdf_writer.hpp"
 #include "extwrench/sim/perturb.hpp"
 #include "support/random.hpp"
+#include "support/text_files.hpp"
 
 namespace extwrench {
 namespace {
 
 namespace fs = std::filesystem;
+using test::read_text;
+using test::write_text;
 
 const fs::path kSource = EXTWRENCH_SOURCE_DIR;
 const fs::path kPaperArm = kSource / "models" / "paper_arm.urdf";
@@ -39,18 +42,6 @@ fs::path temp_dir(const std::string& name) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
-}
-
-void write_file(const fs::path& path, const std::string& text) {
-  std::ofstream out(path);
-  out << text;
-}
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 std::string error_of(const std::function<void()>& f) {
@@ -145,7 +136,7 @@ TEST_F(Replay, LogWithoutVelocitiesIsDifferentiated) {
     for (int i = 1; i <= 7; ++i) text += "," + std::to_string(0.1 * i * t * t);  // q_i = 0.1 i t²
     text += ",0,0,0,0,0,0,0\n";
   }
-  write_file(dir / "log.csv", text);
+  write_text(dir / "log.csv", text);
   LogReader r(dir / "log.csv", robot_->model);
   ASSERT_EQ(r.ignored_columns(), std::vector<std::string>{"extra"});
   EXPECT_FALSE(r.layout().velocity);
@@ -219,7 +210,7 @@ TEST_F(Replay, MalformedLogsAreErrorsNamingLineAndColumn) {
   const fs::path dir = temp_dir("badlogs");
   for (const BadLog& c : cases) {
     const fs::path path = dir / (std::string(c.name) + ".csv");
-    write_file(path, c.text);
+    write_text(path, c.text);
     const std::string what = error_of([&] {
       LogReader r(path, robot_->model);
       Sample s;
@@ -233,7 +224,7 @@ TEST_F(Replay, MalformedLogsAreErrorsNamingLineAndColumn) {
 
 TEST_F(Replay, ConfigNeedingSensorColumnsIsAnErrorOnALogWithout) {
   const fs::path dir = temp_dir("nosensor");
-  write_file(dir / "log.csv", header() + row(0, 21) + row(0.001, 21));
+  write_text(dir / "log.csv", header() + row(0, 21) + row(0.001, 21));
   EstimatorOptions options;
   options.sensor.type = SensorType::kForceTorque;
   ReplayOptions ro;
@@ -246,7 +237,7 @@ TEST_F(Replay, ConfigNeedingSensorColumnsIsAnErrorOnALogWithout) {
             std::string::npos)
       << what;
   // A header without rows.
-  write_file(dir / "empty.csv", header());
+  write_text(dir / "empty.csv", header());
   options.sensor.type = SensorType::kNone;
   ro.log = dir / "empty.csv";
   const std::string what2 =
@@ -318,7 +309,7 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
   const fs::path dir = temp_dir("badscenarios");
   for (const BadLog& c : cases) {
     const fs::path path = dir / (std::string(c.name) + ".yaml");
-    write_file(path, c.text);
+    write_text(path, c.text);
     const std::string what = error_of([&] { (void)load_scenario(path); });
     EXPECT_NE(what.find(c.expected), std::string::npos) << c.name << ": " << what;
     EXPECT_NE(what.find(path.filename().string()), std::string::npos) << c.name << ": " << what;
@@ -328,13 +319,13 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
 TEST_F(Replay, ScenarioNumbersMayBeInfiniteWhereAFiniteValueIsNotRequired) {
   const fs::path dir = temp_dir("infscenario");
   for (const char* inf : {"inf", ".inf"}) {
-    write_file(dir / "s.yaml",
+    write_text(dir / "s.yaml",
                replace(kGoodScenario, "start: 0.1", std::string("start: 0.1, end: ") + inf));
     const Scenario s = load_scenario(dir / "s.yaml");
     ASSERT_EQ(s.simulation.forces.size(), 1U);
     EXPECT_EQ(s.simulation.forces[0].end, std::numeric_limits<double>::infinity()) << inf;
   }
-  write_file(dir / "s.yaml", replace(kGoodScenario, "duration: 0.5", "duration: inf"));
+  write_text(dir / "s.yaml", replace(kGoodScenario, "duration: 0.5", "duration: inf"));
   EXPECT_NE(error_of([&] {
               (void)load_scenario(dir / "s.yaml");
             }).find("duration: expected a value > 0, got inf"),
@@ -343,7 +334,7 @@ TEST_F(Replay, ScenarioNumbersMayBeInfiniteWhereAFiniteValueIsNotRequired) {
 
 TEST_F(Replay, SchemeWithABadEstimatorKeyFailsBeforeSimulatingAndNamesTheScheme) {
   const fs::path dir = temp_dir("badscheme");
-  write_file(dir / "s.yaml",
+  write_text(dir / "s.yaml",
              replace(kGoodScenario, "contact: {model: pure_force}", "contact: {model: magic}"));
   const Scenario s = load_scenario(dir / "s.yaml");
   const std::string what =
@@ -398,11 +389,11 @@ TEST_F(Replay, EstimateFedOnlyTheWrittenFilesReproducesSimulateByteForByte) {
       replace(kGoodScenario, "ft: {sensor: {type: ft}, contact: {model: pure_force}}",
               "ft: {sensor: {type: ft}, contact: {model: pure_force}}\n"
               "  no_sensor: {sensor: {type: none}, contact: {model: pure_force}}");
-  write_file(dir / "s.yaml", scenario);
+  write_text(dir / "s.yaml", scenario);
   ASSERT_EQ(run(std::string(EXTWRENCH_CLI) + " simulate " + (dir / "s.yaml").string() + " --out " +
                 (dir / "sim").string() + " --no-figures > " + (dir / "sim.txt").string() + " 2>&1"),
             0)
-      << read_file(dir / "sim.txt");
+      << read_text(dir / "sim.txt");
   // Only the three files, copied elsewhere: nothing else is shared.
   for (const std::string scheme : {"ft", "no_sensor"}) {
     const fs::path iso = dir / ("iso_" + scheme);
@@ -414,8 +405,8 @@ TEST_F(Replay, EstimateFedOnlyTheWrittenFilesReproducesSimulateByteForByte) {
                   (iso / scheme / "config.yaml").string() + " --log " + (iso / "log.csv").string() +
                   " --out " + (iso / "out").string() + " --no-figures > /dev/null 2>&1"),
               0);
-    const std::string a = read_file(dir / "sim" / scheme / "estimates.csv");
-    const std::string b = read_file(iso / "out" / "estimates.csv");
+    const std::string a = read_text(dir / "sim" / scheme / "estimates.csv");
+    const std::string b = read_text(iso / "out" / "estimates.csv");
     EXPECT_GT(a.size(), 1000u);
     EXPECT_TRUE(a == b) << scheme << ": estimates differ";
   }
@@ -423,16 +414,16 @@ TEST_F(Replay, EstimateFedOnlyTheWrittenFilesReproducesSimulateByteForByte) {
 
 TEST_F(Replay, CommandLineErrorsExitWithTheDocumentedCodes) {
   const fs::path dir = temp_dir("cli");
-  write_file(dir / "bad.yaml", kGoodScenario + "colour: red\n");
+  write_text(dir / "bad.yaml", kGoodScenario + "colour: red\n");
   EXPECT_EQ(run(std::string(EXTWRENCH_CLI) + " simulate " + (dir / "bad.yaml").string() +
                 " --out " + (dir / "o").string() + " > " + (dir / "err.txt").string() + " 2>&1"),
             1);
-  EXPECT_NE(read_file(dir / "err.txt").find("colour: unknown key"), std::string::npos);
+  EXPECT_NE(read_text(dir / "err.txt").find("colour: unknown key"), std::string::npos);
   EXPECT_EQ(run(std::string(EXTWRENCH_CLI) +
                 " estimate --config x.yaml --log y.csv --out z --exclude 3:1 > " +
                 (dir / "err2.txt").string() + " 2>&1"),
             2);
-  EXPECT_NE(read_file(dir / "err2.txt").find("--exclude: expected FROM:TO"), std::string::npos);
+  EXPECT_NE(read_text(dir / "err2.txt").find("--exclude: expected FROM:TO"), std::string::npos);
 }
 
 // ---- the paper's scenario -------------------------------------------------------------------
@@ -551,7 +542,7 @@ TEST_F(Replay, LongLogReplaysInTheMemoryOfAShortOne) {
   const fs::path dir = temp_dir("long");
   write_synthetic_log(dir / "short.csv", 60'000);
   write_synthetic_log(dir / "long.csv", big_rows);
-  write_file(dir / "config.yaml", "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  write_text(dir / "config.yaml", "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
   const std::string common = " --config " + (dir / "config.yaml").string();
   const long short_kb =
       peak_rss_kb_of("estimate" + common + " --log " + (dir / "short.csv").string() + " --out " +

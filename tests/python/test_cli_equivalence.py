@@ -25,6 +25,11 @@ def number(text):
     return float(text) if text != "" else np.nan
 
 
+def candidate_names(est, masks):
+    """The estimates.csv cells of link_candidates from the batch's bit masks (bit l: body l)."""
+    return ["|".join(est.bodies[l] for l in range(64) if int(m) >> l & 1) for m in masks]
+
+
 @pytest.fixture(scope="module")
 def cli_estimates(paper_run, cli, tmp_path_factory):
     """`extwrench estimate` on the simulated log, per scheme."""
@@ -53,9 +58,7 @@ def test_estimate_is_bit_identical_to_the_cli(paper_run, cli_estimates, scheme, 
             names = [est.bodies[i] if i >= 0 else "" for i in got["link"]]
             assert names == list(cells)
         elif name == "link_candidates":
-            # Not yet in the batch output (issue 9 added the column after the bindings were
-            # written): the scenario's schemes use the paper's rule, which leaves it empty.
-            assert set(cells) == {""}
+            assert candidate_names(est, got["link_candidates"]) == list(cells)
         elif name == "contact":
             assert [str(int(c)) for c in got["contact"]] == list(cells)
         else:
@@ -113,3 +116,33 @@ def test_simulate_returns_the_files_numbers(paper_run):
     assert np.array_equal(bits(runs[0]["estimates"]["ft"]["fx"]), bits(fx))
     log = runs[0]["log"]
     assert log["q"].shape == (len(rows), 7) and "true_force_W" in log
+
+
+def test_link_candidates_of_geometry_isolation_match_the_cli(paper_run, cli):
+    # The scenario's push lies outside link 6's capsule: geometry isolation names link 7 and
+    # keeps link 6 as a candidate, so the column is not empty.
+    text = (paper_run["dir"] / "ft" / "config.yaml").read_text()
+    assert "isolation: residual" in text
+    config = paper_run["dir"] / "ft" / "geometry.yaml"  # beside config.yaml: its relative paths
+    config.write_text(text.replace("isolation: residual", "isolation: geometry"))
+    out = paper_run["dir"] / "ft_geometry"
+    subprocess.run([cli, "estimate", "--config", str(config), "--log",
+                    str(paper_run["dir"] / "log.csv"), "--out", str(out), "--no-figures"],
+                   check=True, capture_output=True)
+    est = extwrench.ContactEstimator(None, config)
+    log = extwrench.read_log(paper_run["dir"] / "log.csv", est)
+    got = extwrench.estimate(est, log["t"], log["q"], log["dq"], log["tau"], log["reading"])
+    header, rows = read_csv(out / "estimates.csv")
+    cells = [r[header.index("link_candidates")] for r in rows]
+    assert candidate_names(est, got["link_candidates"]) == cells
+    assert sum(c != "" for c in cells) > len(cells) // 2
+    # One update at a time gives the same candidates as the batch.
+    est.reset(log["t"][0], log["q"][0], log["dq"][0], log["tau"][0])
+    for k in range(1, len(log["t"])):
+        e = est.update(log["t"][k], log["q"][k], log["dq"][k], log["tau"][k], log["reading"][k])
+        if k % 97 == 0:
+            assert e.link_candidates == [l for l in range(64) if int(got["link_candidates"][k]) >> l & 1], k
+    # And written back, the column is the CLI's.
+    path = out / "again.csv"
+    extwrench.write_estimates(path, est, got)
+    assert path.read_bytes() == (out / "estimates.csv").read_bytes()

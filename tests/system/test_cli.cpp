@@ -21,6 +21,7 @@
 #include "extwrench/io/robot_loader.hpp"
 #include "support/random.hpp"
 #include "support/scratch_dir.hpp"
+#include "support/text_files.hpp"
 
 namespace extwrench {
 namespace {
@@ -33,17 +34,8 @@ constexpr int kStates = 50;  // rows of the dynamics round trip (each a full CLI
 
 const fs::path kModels = fs::path(EXTWRENCH_SOURCE_DIR) / "models";
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
+using test::read_text;
+using test::write_text;
 
 ::testing::AssertionResult contains(const std::string& text, const std::string& needle) {
   if (text.find(needle) != std::string::npos) return ::testing::AssertionSuccess();
@@ -80,11 +72,7 @@ std::string word_after(const std::string& text, const std::string& key) {
   return text.substr(begin, text.find_first_of(" \n)", begin) - begin);
 }
 
-struct RunResult {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
+using RunResult = test::CliResult;
 
 /// A scratch directory per test, removed afterwards.
 class Cli : public test::ScratchDirTest {
@@ -93,16 +81,7 @@ class Cli : public test::ScratchDirTest {
 
   /// Runs the binary with `args` (already shell-quoted where needed), capturing both streams.
   RunResult run(const std::string& args, const std::string& stdin_file = "/dev/null") const {
-    const fs::path out = dir_ / "stdout.txt";
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command = std::string("'") + EXTWRENCH_CLI + "' " + args + " >'" +
-                                out.string() + "' 2>'" + err.string() + "' <'" + stdin_file + "'";
-    const int status = std::system(command.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = read_text(out);
-    r.err = read_text(err);
-    return r;
+    return test::run_cli(EXTWRENCH_CLI, args, dir_, stdin_file);
   }
 
   fs::path path(const std::string& name) const { return dir_ / name; }

@@ -20,6 +20,7 @@
 #include "extwrench/model/model_builder.hpp"
 #include "support/build_info.hpp"
 #include "support/scratch_dir.hpp"
+#include "support/text_files.hpp"
 
 namespace extwrench {
 namespace {
@@ -28,17 +29,8 @@ namespace fs = std::filesystem;
 
 const fs::path kPaperArm = fs::path(EXTWRENCH_SOURCE_DIR) / "models" / "paper_arm.urdf";
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
+using test::read_text;
+using test::write_text;
 
 struct CliRun {
   int code = -1;

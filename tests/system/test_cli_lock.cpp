@@ -12,6 +12,7 @@
 #include <string>
 
 #include "support/scratch_dir.hpp"
+#include "support/text_files.hpp"
 namespace extwrench {
 namespace {
 
@@ -21,35 +22,14 @@ const fs::path kTree = fs::path(EXTWRENCH_TEST_DATA_DIR) / "robots/gripper_tree.
 const fs::path kPandaDir =
     fs::path(EXTWRENCH_SHARED_DIR) / "models/franka_panda/urdf_example-robot-data";
 
-struct RunResult {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using RunResult = test::CliResult;
+using test::read_text;
 
 class CliLock : public test::ScratchDirTest {
  protected:
   CliLock() : ScratchDirTest("extwrench_cli_lock") {}
 
-  RunResult run(const std::string& args) const {
-    const fs::path out = dir_ / "stdout.txt";
-    const fs::path err = dir_ / "stderr.txt";
-    const std::string command = std::string("'") + EXTWRENCH_CLI + "' " + args + " >'" +
-                                out.string() + "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(command.c_str());
-    RunResult r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = read_text(out);
-    r.err = read_text(err);
-    return r;
-  }
+  RunResult run(const std::string& args) const { return test::run_cli(EXTWRENCH_CLI, args, dir_); }
 };
 
 TEST_F(CliLock, InfoOnThePandaWithLockedFingersAndItsOwnDirectoryAsPackagePath) {

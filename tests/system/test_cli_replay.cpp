@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "support/text_files.hpp"
+
 namespace extwrench {
 namespace {
 
@@ -20,26 +22,14 @@ namespace fs = std::filesystem;
 
 const fs::path kSource = EXTWRENCH_SOURCE_DIR;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
+using test::read_text;
+using test::write_text;
 
 bool contains(const std::string& text, const std::string& needle) {
   return text.find(needle) != std::string::npos;
 }
 
-struct CliRun {
-  int code = -1;
-  std::string out, err;
-};
+using CliRun = test::CliResult;
 
 bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
@@ -105,11 +95,7 @@ class RealLog : public ::testing::Test {
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 
   static CliRun run(const std::string& args, const std::string& env = "") {
-    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string command = env + " '" + std::string(EXTWRENCH_CLI) + "' " + args + " >'" +
-                                out.string() + "' 2>'" + err.string() + "' </dev/null";
-    const int status = std::system(command.c_str());
-    return CliRun{WIFEXITED(status) ? WEXITSTATUS(status) : 128, read_text(out), read_text(err)};
+    return test::run_cli(EXTWRENCH_CLI, args, dir_, "/dev/null", env);
   }
 
   // The scheme's configuration written by simulate, with `sensor:` replaced (robot path made

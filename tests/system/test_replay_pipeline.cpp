@@ -18,11 +18,14 @@
 #include "extwrench/io/log.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "support/random.hpp"
+#include "support/text_files.hpp"
 
 namespace extwrench {
 namespace {
 
 namespace fs = std::filesystem;
+using test::read_text;
+using test::write_text;
 
 const fs::path kPaperArm = fs::path(EXTWRENCH_SOURCE_DIR) / "models" / "paper_arm.urdf";
 // Rows per hand-off between the threads (kBatchRows in replay.cpp); the tests put rows and
@@ -48,18 +51,6 @@ class ReplayPipeline : public ::testing::Test {
 };
 std::unique_ptr<RobotDescription> ReplayPipeline::robot_;
 fs::path ReplayPipeline::dir_;
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void write_file(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
 
 /// A log of `rows` rows at 1 kHz: smooth joint motion, a noisy F/T reading, a push on link 6
 /// from row 300 (so the estimates go through free, pending and contact).
@@ -99,15 +90,15 @@ void write_log(const fs::path& path, long rows, bool velocity) {
 
 /// The log with data row `row` (0-based) replaced by `text` (a malformed row).
 void corrupt_row(const fs::path& from, const fs::path& to, long row, const std::string& text) {
-  std::istringstream in(read_file(from));
+  std::istringstream in(read_text(from));
   std::string out, line;
   for (long k = -1; std::getline(in, line); ++k) out += (k == row ? text : line) + "\n";
-  write_file(to, out);
+  write_text(to, out);
 }
 
 /// The same data row with cell `cell` (0-based) replaced.
 std::string row_with_cell(const fs::path& log, long row, int cell, const std::string& value) {
-  std::istringstream in(read_file(log));
+  std::istringstream in(read_text(log));
   std::string line;
   for (long k = -1; std::getline(in, line) && k < row; ++k) {
   }
@@ -158,7 +149,7 @@ Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& option
   } catch (const Error& e) {
     o.error = e.what();
   }
-  o.estimates = read_file(out_dir / "estimates.csv");
+  o.estimates = read_text(out_dir / "estimates.csv");
   return o;
 }
 
@@ -175,7 +166,7 @@ Outcome pipelined(const RobotDescription& robot, const EstimatorOptions& options
   } catch (const Error& e) {
     o.error = e.what();
   }
-  o.estimates = read_file(out_dir / "estimates.csv");
+  o.estimates = read_text(out_dir / "estimates.csv");
   return o;
 }
 

@@ -44,7 +44,10 @@ class ContactDetector {
  public:
   ContactDetector() = default;
   /// Throws extwrench::Error on sizes other than 1 or n, or values out of range (validate).
-  ContactDetector(const DetectionOptions& options, int n);
+  /// release_settle_time [s]: how long τ̂_ext may take to decay after the force ends (the
+  /// estimator passes 5 time constants of its residual).
+  ContactDetector(const DetectionOptions& options, int n,
+                  double release_settle_time = std::numeric_limits<double>::infinity());
 
   void reset() noexcept;
   /// τ̂_ext (n) and ‖F̂_ext‖ (NaN when there is no usable base force) at time t. No allocation.
@@ -52,6 +55,11 @@ class ContactDetector {
   /// sensor), NaN when unknown. When finite, a declared contact is released once it falls below
   /// release_ratio × f_min, however slowly τ̂_ext decays; a new onset then waits until every
   /// joint and the base force have fallen below their release levels (one rising edge each).
+  /// If `release_settle_time` after the release the signals have not even halved (relative to
+  /// their thresholds; a force that ended leaves a residual decaying to < 1 % by then), the
+  /// force is still there and the release was wrong (the sensor's instantaneous force assumes
+  /// the isolated link, which may be the wrong one): the contact is declared again and the
+  /// sensor may not release it until every threshold has dropped.
   const DetectionResult& update(double t, const Eigen::Ref<const VectorX>& tau_ext,
                                 double base_force_norm,
                                 double release_force_norm = kNoReleaseForce) noexcept;
@@ -69,8 +77,16 @@ class ContactDetector {
   bool have_edge_ = false;  ///< edge_time_ is valid
   double edge_time_ = 0.0;  ///< when the raw detection last changed against `declared_`
   int last_link_ = -1;
-  bool rearm_ = false;  ///< released by the sensor while thresholds were still over
+  bool rearm_ = false;                ///< released by the sensor while thresholds were still over
+  double release_time_ = 0.0;         ///< when the sensor last released [s]
+  double release_level_ = 0.0;        ///< the signals' level (level()) at that release
+  double release_settle_time_ = 0.0;  ///< see the constructor [s]
+  bool sensor_release_disproved_ = false;  ///< no sensor release until every threshold drops
   DetectionResult result_;
+
+  /// max(|τ̂_ext,i| / τ_min,i, ‖F̂‖ / F_min): how far over its threshold the strongest signal is.
+  [[nodiscard]] double level(const Eigen::Ref<const VectorX>& tau_ext,
+                             double base_force_norm) const noexcept;
 };
 
 /// The EstimateFlag bits of a detection result: contact, pending, base only.
