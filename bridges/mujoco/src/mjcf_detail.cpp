@@ -134,8 +134,11 @@ void collect_geoms(const mjModel* m, const std::string& file, int b, std::vector
         spec.mesh = m->geom_dataid[g];
         break;
       default:
-        throw Error(spec.source + ": unsupported collision geom type " +
-                    std::to_string(m->geom_type[g]) +
+        throw Error(spec.source + ": unsupported collision geom type '" +
+                    (m->geom_type[g] == mjGEOM_PLANE    ? std::string("plane")
+                     : m->geom_type[g] == mjGEOM_HFIELD ? std::string("hfield")
+                                                        : std::to_string(m->geom_type[g])) +
+                    "'" +
                     " on a robot link (expected sphere, capsule, cylinder, box, ellipsoid or mesh; "
                     "set contype=\"0\" conaffinity=\"0\" to make it visual only)");
     }
