@@ -2,6 +2,7 @@
 // kept out of MUJOCO_LOG.TXT while it does, and its errors become extwrench::Error.
 #include <mujoco/mujoco.h>
 
+#include <cstring>
 #include <memory>
 #include <mutex>
 
@@ -30,15 +31,16 @@ std::string one_line(std::string text) {
 std::mutex g_load_mutex;
 void ignore_warning(const char* /*message*/) {}
 
-std::unique_ptr<mjModel, ModelDeleter> compile(const std::filesystem::path& path) {
+// Compiles `path` (a file, or the one file of `vfs`); `name` prefixes the errors.
+std::unique_ptr<mjModel, ModelDeleter> compile(const std::string& path, const mjVFS* vfs,
+                                               const std::string& name) {
   const std::lock_guard<std::mutex> lock(g_load_mutex);
   void (*previous)(const char*) = mju_user_warning;
   mju_user_warning = ignore_warning;
   char error[2048] = "";
-  std::unique_ptr<mjModel, ModelDeleter> m(
-      mj_loadXML(path.string().c_str(), nullptr, error, sizeof error));
+  std::unique_ptr<mjModel, ModelDeleter> m(mj_loadXML(path.c_str(), vfs, error, sizeof error));
   mju_user_warning = previous;
-  if (!m) throw Error(path.string() + ": MuJoCo rejects the MJCF: " + one_line(error));
+  if (!m) throw Error(name + ": MuJoCo rejects the MJCF: " + one_line(error));
   return m;
 }
 
@@ -46,9 +48,31 @@ std::unique_ptr<mjModel, ModelDeleter> compile(const std::filesystem::path& path
 
 RobotDescription load_mjcf(const std::filesystem::path& path, const LoadOptions& options) {
   check_input_file(path, "robot", kMaxTextFileBytes);
-  const auto m = compile(path);
+  const auto m = compile(path.string(), nullptr, path.string());
   RobotDescription robot = robot_from_mjmodel(m.get(), path.string(), options);
   robot.source = path;
+  return robot;
+}
+
+RobotDescription load_mjcf_string(const std::string& xml, const std::string& name,
+                                  const LoadOptions& options) {
+  constexpr const char* kVfsName = "robot.xml";
+  struct VfsDeleter {
+    void operator()(mjVFS* vfs) const {
+      mj_deleteVFS(vfs);
+      delete vfs;
+    }
+  };
+  std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);  // large (2000 file names): not on the stack
+  mj_defaultVFS(vfs.get());
+  if (xml.size() > kMaxTextFileBytes ||
+      mj_makeEmptyFileVFS(vfs.get(), kVfsName, static_cast<int>(xml.size()) + 1) != 0) {
+    throw Error(name + ": the MJCF text is too large");
+  }
+  std::memcpy(vfs->filedata[0], xml.c_str(), xml.size() + 1);
+  const auto m = compile(kVfsName, vfs.get(), name);
+  RobotDescription robot = robot_from_mjmodel(m.get(), name, options);
+  robot.source = name;
   return robot;
 }
 

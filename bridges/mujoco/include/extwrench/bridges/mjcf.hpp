@@ -19,6 +19,11 @@ namespace extwrench::mujoco {
 [[nodiscard]] RobotDescription load_mjcf(const std::filesystem::path& path,
                                          const LoadOptions& options = {});
 
+/// MJCF from a string (MuJoCo's virtual file system); `name` stands for the file in errors.
+/// Files it names (meshes, includes) are looked up relative to the working directory.
+[[nodiscard]] RobotDescription load_mjcf_string(const std::string& xml, const std::string& name,
+                                                const LoadOptions& options = {});
+
 /// The robot rooted at `options.root_body` (or the one top-level body with joints) of a
 /// compiled model: its bodies (compiled mass, CoM, principal inertia), hinge and slide joints
 /// (axis, anchor, reference, range, damping, frictionloss, armature), sites as frames, and
