@@ -21,6 +21,15 @@ Pose pose(const mjtNum* pos, const mjtNum* quat) {
   return X;
 }
 
+Pose pose_from_matrix(const mjtNum* pos, const mjtNum* mat) {
+  Pose X;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) X.rotation(i, j) = mat[3 * i + j];
+    X.translation[i] = pos[i];
+  }
+  return X;
+}
+
 std::string body_name(const mjModel* m, int b) {
   const char* name = mj_id2name(m, mjOBJ_BODY, b);
   if (name != nullptr && name[0] != '\0') return name;

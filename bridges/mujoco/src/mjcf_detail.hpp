@@ -17,6 +17,8 @@ inline Vector3 vec3(const mjtNum* p) { return {p[0], p[1], p[2]}; }
 Matrix3 quat_rotation(const mjtNum* quat);
 /// The pose (pos, quat), e.g. X_{body, geom} from geom_pos, geom_quat.
 Pose pose(const mjtNum* pos, const mjtNum* quat);
+/// The world pose from MuJoCo's position and row-major matrix (xpos/xmat, site_xpos/xmat).
+Pose pose_from_matrix(const mjtNum* pos, const mjtNum* mat);
 /// X_{parent body, body} at qpos0 (body_pos, body_quat).
 inline Pose body_offset(const mjModel* m, int b) {
   return pose(m->body_pos + 3 * b, m->body_quat + 4 * b);
