@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <span>
 #include <string>
 
 #include "extwrench/bridges/mjcf.hpp"
@@ -35,6 +36,39 @@ std::string scene_with_box(const std::string& path) {
   return xml;
 }
 
+// MuJoCo's model of the same text, from memory.
+mjModel* compile(const std::string& xml) {
+  auto* vfs = new mjVFS;  // 2 MB of file names: not on the stack
+  mj_defaultVFS(vfs);
+  mj_makeEmptyFileVFS(vfs, "scene.xml", static_cast<int>(xml.size()) + 1);
+  std::memcpy(vfs->filedata[0], xml.c_str(), xml.size() + 1);
+  char error[1000] = "";
+  mjModel* m = mj_loadXML("scene.xml", vfs, error, sizeof error);
+  mj_deleteVFS(vfs);
+  delete vfs;
+  if (m == nullptr) std::fprintf(stderr, "MuJoCo: %s\n", error);
+  return m;
+}
+
+void print_row(double t, const Model& model, std::span<const mujoco::BodyContactTruth> contacts,
+               const ContactEstimate& e) {
+  // The truth: the resultant over the links in contact, the point of the most loaded one.
+  mujoco::BodyContactTruth truth;
+  Vector3 force_W = Vector3::Zero();
+  for (const auto& contact : contacts) {
+    force_W += contact.force_W;
+    if (truth.body < 0 || contact.force_W.norm() > truth.force_W.norm()) truth = contact;
+  }
+  truth.force_W = force_W;
+  std::printf(
+      "%6.2f | %-7s [%7.2f %7.2f %7.2f] [%6.3f %6.3f %6.3f] | %-7s [%7.2f %7.2f %7.2f] "
+      "[%6.3f %6.3f %6.3f]\n",
+      t, contacts.empty() ? "-" : model.bodies[truth.body].name.c_str(), truth.force_W.x(),
+      truth.force_W.y(), truth.force_W.z(), truth.point_W.x(), truth.point_W.y(), truth.point_W.z(),
+      e.contact ? model.bodies[e.link].name.c_str() : "-", e.force_W.x(), e.force_W.y(),
+      e.force_W.z(), e.point_W.x(), e.point_W.y(), e.point_W.z());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -46,18 +80,8 @@ int main(int argc, char** argv) {
   const Model& model = robot.model;
   const int n = model.nq();
 
-  mjVFS* vfs = new mjVFS;
-  mj_defaultVFS(vfs);
-  mj_makeEmptyFileVFS(vfs, "scene.xml", static_cast<int>(xml.size()) + 1);
-  std::memcpy(vfs->filedata[0], xml.c_str(), xml.size() + 1);
-  char error[1000] = "";
-  mjModel* m = mj_loadXML("scene.xml", vfs, error, sizeof error);
-  mj_deleteVFS(vfs);
-  delete vfs;
-  if (m == nullptr) {
-    std::fprintf(stderr, "MuJoCo: %s\n", error);
-    return 1;
-  }
+  mjModel* m = compile(xml);
+  if (m == nullptr) return 1;
   m->opt.timestep = 0.001;
   m->opt.integrator = mjINT_EULER;  // mj_forward + bridge + mj_Euler = mj_step
   mjData* d = mj_makeData(m);
@@ -104,18 +128,7 @@ int main(int argc, char** argv) {
       std::printf("estimator: %s\n", std::string(to_string(status.code)).c_str());
       return 1;
     }
-    if (k % 100 == 0) {
-      const ContactEstimate& e = estimator.result();
-      const auto contacts = bridge.contacts();
-      const auto& truth = contacts.empty() ? mujoco::BodyContactTruth{} : contacts[0];
-      std::printf(
-          "%6.2f | %-7s [%7.2f %7.2f %7.2f] [%6.3f %6.3f %6.3f] | %-7s [%7.2f %7.2f %7.2f] "
-          "[%6.3f %6.3f %6.3f]\n",
-          t, contacts.empty() ? "-" : model.bodies[truth.body].name.c_str(), truth.force_W.x(),
-          truth.force_W.y(), truth.force_W.z(), truth.point_W.x(), truth.point_W.y(),
-          truth.point_W.z(), e.contact ? model.bodies[e.link].name.c_str() : "-", e.force_W.x(),
-          e.force_W.y(), e.force_W.z(), e.point_W.x(), e.point_W.y(), e.point_W.z());
-    }
+    if (k % 100 == 0) print_row(t, model, bridge.contacts(), estimator.result());
     mj_Euler(m, d);
   }
   std::printf("estimator update: mean %.2f us, worst %.2f us over %ld steps\n",
