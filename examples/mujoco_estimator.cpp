@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
   mujoco::MujocoBridge bridge(m, model);
   EstimatorOptions options;
   options.sensor.type = SensorType::kForceTorque;
-  options.sensor.pose =
+  options.sensor.X_WS =
       model.frames[static_cast<std::size_t>(model.frame_index("sensor"))].placement;
   options.contact.model = ContactModel::kPureForce;
   options.observer_gain = VectorX::Constant(1, 100.0);

@@ -132,6 +132,16 @@ TEST_F(MjcfMalformed, SceneWithTwoRobotsAsksForTheRoot) {
   EXPECT_EQ(robot.model.joints[1].name, "oj");
 }
 
+TEST_F(MjcfMalformed, WorldAsRootKeepsEveryTopLevelBodyButNotTheFloor) {
+  std::string text = arm();
+  text.insert(text.find("<body name=\"base\""),
+              "<geom name=\"floor\" type=\"plane\" size=\"1 1 1\"/>\n");
+  const RobotDescription robot = mujoco::load_mjcf(write("world.xml", text), chain("world"));
+  EXPECT_EQ(robot.model.bodies[0].name, "world");
+  EXPECT_EQ(robot.model.nq(), 1);
+  EXPECT_TRUE(robot.geometry.shapes.empty());
+}
+
 TEST_F(MjcfMalformed, UnknownRootOrTipNamesTheOption) {
   const std::string path = write("arm.xml", arm());
   EXPECT_TRUE(has_all(error_of(path, chain("nope")), {path, "root_body 'nope'", "'base'"}));

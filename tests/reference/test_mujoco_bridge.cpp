@@ -96,7 +96,7 @@ TEST_F(MujocoBridgeTest, SampleIsMujocosStateAndTruthExplainsTheBaseReading) {
     VectorX qacc(model.nq());
     for (int i = 0; i < model.nq(); ++i) qacc[i] = d_->qacc[i];
     (void)rnea(model, data, s.q, s.dq, qacc);
-    const Vector6 difference_S = s.sensor - sensor_reading(data, X_WS_);
+    const Vector6 difference_S = s.reading_S - sensor_reading(data, X_WS_);
     Vector3 force_W = Vector3::Zero(), moment_S_W = Vector3::Zero();
     for (const auto& contact : bridge.contacts()) {
       force_W += contact.force_W;

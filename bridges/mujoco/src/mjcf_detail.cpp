@@ -113,6 +113,8 @@ void ellipsoid_to_capsule(const Vector3& semi_axes, CollisionShape& s) {
 void collect_geoms(const mjModel* m, const std::string& file, int b, std::vector<GeomSpec>& geoms) {
   for (int g = m->body_geomadr[b]; g >= 0 && g < m->body_geomadr[b] + m->body_geomnum[b]; ++g) {
     if (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) continue;  // visual only
+    // The world's planes and height fields are the ground, not part of a robot rooted there.
+    if (b == 0 && (m->geom_type[g] == mjGEOM_PLANE || m->geom_type[g] == mjGEOM_HFIELD)) continue;
     GeomSpec spec;
     spec.body = body_name(m, b);
     spec.source = geom_where(m, file, b, g);

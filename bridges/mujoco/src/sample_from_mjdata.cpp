@@ -37,16 +37,6 @@ Vector3 frame_times(const mjtNum* frame, const mjtNum* local) {
   return v;
 }
 
-// The Sample and Truth fields the bridge writes, in one place (issue 8 renames them to
-// reading_S, force_W, moment_W, point_W).
-void set_reading(Sample& sample, const Vector6& reading_S) { sample.sensor = reading_S; }
-void set_truth_wrench(Truth& truth, const Vector3& force_W, const Vector3& moment_W,
-                      const Vector3& point_W) {
-  truth.force = force_W;
-  truth.moment = moment_W;
-  truth.point = point_W;
-}
-
 }  // namespace
 
 MujocoBridge::MujocoBridge(const mjModel* m, const Model& model, BridgeOptions options)
@@ -119,7 +109,7 @@ void MujocoBridge::read_measurements(const mjData* d) noexcept {
     if (options_.force_noise_S > 0.0) reading_S[i] += options_.force_noise_S * rng_.normal();
     if (options_.moment_noise_S > 0.0) reading_S[3 + i] += options_.moment_noise_S * rng_.normal();
   }
-  set_reading(sample_, reading_S);
+  sample_.reading_S = reading_S;
 }
 
 // One wrench on MuJoCo body mj_body, MuJoCo world frame: a force at a point and a torque.
@@ -208,7 +198,9 @@ void MujocoBridge::finish_truth() noexcept {
     moment_W += out.moment_W;
   }
   truth.contacts = num_contacts_;
-  set_truth_wrench(truth, force_W, moment_W, point_W);
+  truth.force_W = force_W;
+  truth.moment_W = moment_W;
+  truth.point_W = point_W;
 }
 
 }  // namespace extwrench::mujoco
