@@ -15,6 +15,8 @@ struct InfoOptions {
   std::filesystem::path robot;
   std::vector<std::filesystem::path> package_path;
   std::vector<std::string> lock;
+  std::string root_body;  ///< MJCF only
+  std::string tip_body;   ///< MJCF only
 };
 
 std::string joint_type_name(JointType type) {
@@ -74,8 +76,10 @@ std::string limits_text(const Joint& j) {
 }
 
 void run_info(const InfoOptions& opt) {
-  const RobotDescription robot =
-      load_robot_file(opt.robot, robot_load_options(opt.package_path, opt.lock));
+  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  load.root_body = opt.root_body;
+  load.tip_body = opt.tip_body;
+  const RobotDescription robot = load_robot_file(opt.robot, load);
   const Model& model = robot.model;
   std::ostringstream out;
 
@@ -140,11 +144,19 @@ void register_info(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("info",
                                      "Print what a robot file contains: links, joints, masses, "
                                      "frames, sensor pose, collision shapes");
-  sub->add_option("ROBOT", opt->robot, "Robot file: URDF (.urdf, .xml) or DH table (.yaml, .yml)")
+  sub->add_option("ROBOT", opt->robot,
+                  "Robot file: URDF (.urdf, .xml), DH table (.yaml, .yml) or MJCF (.xml, .mjcf "
+                  "with root <mujoco>, when built with MuJoCo)")
       ->required()
       ->type_name("FILE");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
+  sub->add_option("--root-body", opt->root_body,
+                  "MJCF only: the body that becomes link 0 (for a scene with several bodies)")
+      ->type_name("BODY");
+  sub->add_option("--tip-body", opt->tip_body,
+                  "MJCF only: keep only the chain from the root body to BODY")
+      ->type_name("BODY");
   sub->footer("\nExample:\n  extwrench info models/paper_arm.urdf");
   sub->callback([opt] { run_info(*opt); });
 }

@@ -4,6 +4,9 @@
 
 #include "commands.hpp"
 #include "extwrench/core/error.hpp"
+#ifdef EXTWRENCH_HAVE_MUJOCO
+#include "extwrench/bridges/mjcf.hpp"
+#endif
 
 #ifndef EXTWRENCH_VERSION
 #define EXTWRENCH_VERSION "unknown"
@@ -44,6 +47,9 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.footer(kFooter);
 
+#ifdef EXTWRENCH_HAVE_MUJOCO
+  extwrench::mujoco::register_mjcf_loader();  // load_robot reads MJCF (docs/mujoco.md)
+#endif
   // One line per subcommand; each lives in its own file.
   extwrench::cli::register_info(app);
   extwrench::cli::register_dynamics(app);

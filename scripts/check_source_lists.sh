@@ -12,6 +12,8 @@ check() {  # $1 = file, $2 = the CMakeLists.txt that must list it, $3 = the name
 }
 while IFS= read -r f; do check "$f" CMakeLists.txt "$f"; done \
   < <(find src cli examples -name '*.cpp' | sort)
+while IFS= read -r f; do check "$f" bridges/mujoco/CMakeLists.txt "${f#bridges/mujoco/}"; done \
+  < <(find bridges/mujoco -name '*.cpp' 2>/dev/null | sort)
 while IFS= read -r f; do check "$f" python/CMakeLists.txt "${f#python/}"; done \
   < <(find python -maxdepth 1 -name '*.[ch]pp' 2>/dev/null | sort)
 while IFS= read -r f; do check "$f" benchmarks/CMakeLists.txt "${f#benchmarks/}"; done \

@@ -55,6 +55,12 @@ class UrdfParser {
                   ": not well-formed XML: " + (doc.ErrorStr() ? doc.ErrorStr() : "unknown error"));
     }
     const XMLElement* robot = doc.RootElement();
+    if (robot != nullptr && std::strcmp(robot->Name(), "mujoco") == 0) {
+      throw Error(file_ + ":" + std::to_string(robot->GetLineNum()) +
+                  ": the root element is <mujoco>: an MJCF file. MJCF needs extwrench built with "
+                  "MuJoCo (libmujoco-dev, -DEXTWRENCH_BUILD_MUJOCO=ON) and read through "
+                  "load_robot in a program linked with extwrench::mujoco (the extwrench CLI is)");
+    }
     if (robot == nullptr || std::strcmp(robot->Name(), "robot") != 0) {
       throw Error(file_ + ":" + std::to_string(robot ? robot->GetLineNum() : 1) +
                   ": the root element must be <robot>, got <" + (robot ? robot->Name() : "") + ">");

@@ -83,6 +83,9 @@ const std::map<std::string, Expected>& cases() {
       {"root_not_robot.urdf", {2, {"the root element must be <robot>, got <model>"}}},
       {"massless_leaf.urdf",
        {11, {"joint 'j1'", "link 'arm'", "mass matrix is not positive definite"}}},
+      // ---- MJCF in a program without extwrench::mujoco (tests/reference reads it)
+      {"mjcf_without_mujoco.xml",
+       {2, {"the root element is <mujoco>", "MJCF needs extwrench built with MuJoCo"}}},
       // ---- DH YAML
       {"convention_missing.yaml", {1, {"convention: missing"}}},
       {"convention_unknown.yaml",

@@ -138,6 +138,19 @@ TEST(Urdf, GravityCanBeOverridden) {
 
 // ---- the shared validation models ------------------------------------------------------------
 
+TEST(Urdf, MjcfOnlyOptionsAreRefusedNamingThem) {
+  LoadOptions options;
+  options.root_body = "link0";
+  const fs::path file = test::project_models() / "paper_arm.urdf";
+  try {
+    (void)load_robot(file, options);
+    ADD_FAILURE() << "root_body accepted for a URDF";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(file.string() + ": root_body/tip_body"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(UrdfShared, PandaLoadsAsATreeWithItsFingers) {
   REQUIRE_SHARED();
   const Model m = load_robot(panda_dir() / "urdf/panda.urdf", no_meshes()).model;

@@ -38,6 +38,7 @@
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "reference/mujoco_util.hpp"
 #include "reference/reference_util.hpp"
 #include "support/random.hpp"
 
@@ -56,13 +57,6 @@ const char* const kCompiler =
     "balanceinertia=\"false\" inertiafromgeom=\"false\" boundmass=\"0\" boundinertia=\"0\"/>"
     "</mujoco>";
 
-struct Worst {
-  std::string what;
-  double value = 0.0;
-  void update(double e) { value = std::max(value, e); }
-  ~Worst() { std::printf("[ worst    ] %-48s %.3e\n", what.c_str(), value); }
-};
-
 struct RobotCase {
   const char* name;
   std::string urdf_path;
@@ -78,23 +72,9 @@ std::string case_path(const RobotCase& c) {
   return std::string(c.shared ? EXTWRENCH_SHARED_DIR : EXTWRENCH_SOURCE_DIR) + "/" + c.urdf_path;
 }
 
-struct MjModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct MjDataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
-
-Pose body_pose(const mjData* d, int b) {
-  Pose X;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) X.rotation(i, j) = d->xmat[9 * b + 3 * i + j];
-    X.translation[i] = d->xpos[3 * b + i];
-  }
-  return X;
-}
-
-Vector3 vec3(const mjtNum* p) { return {p[0], p[1], p[2]}; }
+Vector3 vec3(const mjtNum* p) { return test::mj_vec3(p); }
+using test::body_pose;
+using test::Worst;
 
 class MujocoReference : public ::testing::TestWithParam<RobotCase> {
  protected:
@@ -201,8 +181,8 @@ class MujocoReference : public ::testing::TestWithParam<RobotCase> {
   void run(bool with_wrenches, unsigned seed);
 
   RobotDescription robot_;
-  std::unique_ptr<mjModel, MjModelDeleter> m_;
-  std::unique_ptr<mjData, MjDataDeleter> d_;
+  test::MjModelPtr m_;
+  test::MjDataPtr d_;
   std::vector<std::pair<int, int>> dof_to_q_;  ///< (MuJoCo dof, our q index)
   std::vector<int> body_frame_;                ///< MuJoCo body b -> our frame body_frame_[b - 1]
   Pose X_WS_ = kArbitrarySensor;

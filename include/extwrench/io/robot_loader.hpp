@@ -1,5 +1,6 @@
-// Loading a robot description (URDF or DH YAML) into a validated Model and its collision
-// geometry. Throws extwrench::Error naming the file, line and field of any problem.
+// Loading a robot description (URDF, DH YAML, or MJCF through the optional extwrench::mujoco)
+// into a validated Model and its collision geometry. Throws extwrench::Error naming the file, line
+// and field of any problem.
 #pragma once
 
 #include <filesystem>
@@ -30,6 +31,12 @@ struct LoadOptions {
   /// Where each lock was given, prefixing its errors ("--lock", "config.yaml:4:
   /// locked_joints.NAME"); a joint missing here is named "locked_joints".
   std::map<std::string, std::string> locked_joint_sources;
+  /// MJCF only (docs/mujoco.md): the body that becomes link 0, for a file holding a scene;
+  /// empty: the one top-level body whose subtree has joints.
+  std::string root_body;
+  /// MJCF only: keep just the bodies on the path root_body -> tip_body (one chain of a tree or
+  /// a scene); empty: the root body's whole subtree.
+  std::string tip_body;
 };
 
 /// Hands `options.locked_joints` to `builder` (used by every loader).
@@ -42,7 +49,16 @@ struct RobotDescription {
   std::filesystem::path source;
 };
 
-/// Loads a URDF (.urdf, .xml) or a DH table (.yaml, .yml), chosen by extension.
+/// Reads an MJCF file into a RobotDescription (extwrench::mujoco's load_mjcf).
+using MjcfLoader = RobotDescription (*)(const std::filesystem::path& path,
+                                        const LoadOptions& options);
+/// Installs the MJCF reader that load_robot uses for an .xml or .mjcf file whose root element is
+/// <mujoco> (extwrench::mujoco's register_mjcf_loader() calls this; nullptr removes it). The io
+/// library does not link MuJoCo: without a reader, such a file gets an error saying so.
+void set_mjcf_loader(MjcfLoader loader) noexcept;
+
+/// Loads a URDF (.urdf, .xml), a DH table (.yaml, .yml) or, when an MJCF reader is installed,
+/// an MJCF file (.xml, .mjcf whose root element is <mujoco>), chosen by extension and root.
 [[nodiscard]] RobotDescription load_robot(const std::filesystem::path& path,
                                           const LoadOptions& options = {});
 [[nodiscard]] RobotDescription load_urdf(const std::filesystem::path& path,
