@@ -256,7 +256,8 @@ std::vector<SeedResult> run_jobs_of(const Scenario& s, const std::filesystem::pa
       n_seeds,
       [&](std::size_t i) { simulate_job(s, singular_body, progress, *seed_outputs[i], seeds[i]); },
       jobs);
-  rethrow_first_failure(simulated, seed_label(simulated.first_failure()));
+  if (const std::size_t failed = simulated.first_failure(); failed < n_seeds)
+    rethrow_first_failure(simulated, seed_label(failed));
 
   std::vector<OutputFiles*> replay_outputs(n_seeds * n_schemes);
   std::vector<std::ostringstream> messages(replay_outputs.size());
