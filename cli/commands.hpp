@@ -71,6 +71,16 @@ void print_metrics_header();
 void print_metrics_row(const std::string& scheme, const std::string& seed, const sim::Metrics& m,
                        const sim::Metrics* outside, double peak_condition);
 
+/// The same lines as text (a job's output, buffered to print in order).
+[[nodiscard]] std::string metrics_header();
+[[nodiscard]] std::string metrics_row(const std::string& scheme, const std::string& seed,
+                                      const sim::Metrics& m, const sim::Metrics* outside,
+                                      double peak_condition);
+
+/// Adds `--jobs N` (N ≥ 1, else a usage error; default app/jobs.hpp's default_jobs(), the
+/// number of cores) to a subcommand; `what` names the jobs ("Logs replayed").
+void add_jobs_option(CLI::App& sub, int& jobs, const std::string& what);
+
 /// Number for humans: up to 10 significant digits ("17.9", "-0.0875", "1e-06").
 [[nodiscard]] std::string fmt(double value);
 /// "(x, y, z)" with fmt.

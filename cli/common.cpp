@@ -4,6 +4,7 @@
 #include <string_view>
 
 #include "commands.hpp"
+#include "extwrench/app/jobs.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -116,21 +117,41 @@ std::string cell(double v, const char* format) {
 
 }  // namespace
 
-void print_metrics_header() {
-  std::printf("%-12s %6s %10s %9s %9s %10s %10s %9s %7s %9s %12s\n", "scheme", "seed", "F RMS [N]",
-              "F max [N]", "F RMS*[N]", "line RMS", "line max", "link [%]", "missed", "false al.",
-              "peak cond");
+std::string metrics_header() {
+  char line[256];
+  std::snprintf(line, sizeof line, "%-12s %6s %10s %9s %9s %10s %10s %9s %7s %9s %12s\n", "scheme",
+                "seed", "F RMS [N]", "F max [N]", "F RMS*[N]", "line RMS", "line max", "link [%]",
+                "missed", "false al.", "peak cond");
+  return line;
 }
+
+std::string metrics_row(const std::string& scheme, const std::string& seed, const sim::Metrics& m,
+                        const sim::Metrics* outside, double peak_condition) {
+  char line[512];
+  std::snprintf(
+      line, sizeof line, "%-12s %6s %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n", scheme.c_str(),
+      seed.c_str(), cell(m.force.rms(), "%.3f").c_str(), cell(m.force.max, "%.2f").c_str(),
+      outside ? cell(outside->force.rms(), "%.3f").c_str() : "-",
+      cell(m.line.rms(), "%.4f").c_str(), cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
+      cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
+      cell(peak_condition, "%.3g").c_str());
+  return line;
+}
+
+void print_metrics_header() { std::fputs(metrics_header().c_str(), stdout); }
 
 void print_metrics_row(const std::string& scheme, const std::string& seed, const sim::Metrics& m,
                        const sim::Metrics* outside, double peak_condition) {
-  std::printf("%-12s %6s %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n", scheme.c_str(),
-              seed.c_str(), cell(m.force.rms(), "%.3f").c_str(), cell(m.force.max, "%.2f").c_str(),
-              outside ? cell(outside->force.rms(), "%.3f").c_str() : "-",
-              cell(m.line.rms(), "%.4f").c_str(),
-              cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
-              cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
-              cell(peak_condition, "%.3g").c_str());
+  std::fputs(metrics_row(scheme, seed, m, outside, peak_condition).c_str(), stdout);
+}
+
+void add_jobs_option(CLI::App& sub, int& jobs, const std::string& what) {
+  jobs = default_jobs();
+  sub.add_option("--jobs", jobs,
+                 what + " at once (default: the number of cores, here " + std::to_string(jobs) +
+                     "); the results do not depend on it")
+      ->type_name("N")
+      ->check(CLI::Range(1, 1024));
 }
 
 std::string fmt(double value) {

@@ -1,12 +1,17 @@
-// extwrench estimate: replays a robot log (real or simulated) through the contact estimator.
+// extwrench estimate: replays robot logs (real or simulated) through the contact estimator,
+// several at once with --jobs.
+#include <glob.h>
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <sstream>
 
 #include "commands.hpp"
+#include "extwrench/app/jobs.hpp"
 #include "extwrench/app/replay.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/estimator_config.hpp"
@@ -18,8 +23,9 @@ namespace {
 
 struct EstimateOptions {
   std::filesystem::path config;
-  std::filesystem::path log;
+  std::vector<std::string> logs;  // files or patterns
   std::filesystem::path out;
+  int jobs = 1;
   // As `simulate` (a scenario's metrics.from default): after the residual's transient.
   double metrics_from = 0.2;
   double metrics_to = std::numeric_limits<double>::infinity();
@@ -43,21 +49,100 @@ std::pair<double, double> parse_interval(const std::string& text) {
   return {*a, *b};
 }
 
-void run_estimate(const EstimateOptions& opt) {
-  sim::MetricsWindow window{opt.metrics_from, opt.metrics_to, {}};
-  std::string description = "t >= " + format_number(opt.metrics_from) + " s";
-  for (const auto& e : opt.exclude) {
-    window.exclude.push_back(parse_interval(e));
-    description += ", excluding [" + e + "] s";
-  }
-  if (!(opt.plot_points >= 10)) throw UsageError("--plot-points must be at least 10");
-  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
-  const EstimatorConfig config = load_estimator_config(opt.config, load);
-  check_input_file(opt.log, "log");
+// The logs of the --log values: a value naming a file is that file; one with *, ? or [ that
+// names no file is a pattern, expanded here with glob(3) (sorted), so that a quoted pattern
+// works without a shell and never hits the shell's argument limit.
+struct LogInputs {
+  std::vector<std::filesystem::path> logs;
+  bool per_log_dirs = false;  // DIR/<log stem>/ per log: several logs, or any pattern
+};
 
+LogInputs expand_logs(const std::vector<std::string>& values) {
+  LogInputs in;
+  for (const std::string& value : values) {
+    std::error_code ec;
+    if (value.find_first_of("*?[") == std::string::npos || std::filesystem::exists(value, ec)) {
+      in.logs.emplace_back(value);
+      continue;
+    }
+    in.per_log_dirs = true;
+    glob_t matches{};
+    const int rc = ::glob(value.c_str(), 0, nullptr, &matches);
+    for (std::size_t i = 0; rc == 0 && i < matches.gl_pathc; ++i)
+      in.logs.emplace_back(matches.gl_pathv[i]);
+    ::globfree(&matches);
+    if (rc != 0) throw Error("--log '" + value + "': no file matches the pattern");
+  }
+  in.per_log_dirs = in.per_log_dirs || in.logs.size() > 1;
+  return in;
+}
+
+// DIR/<stem>/ per log; two logs of one stem would write the same files: a usage error.
+std::vector<std::filesystem::path> output_dirs(const LogInputs& in,
+                                               const std::filesystem::path& out) {
+  std::vector<std::filesystem::path> dirs;
+  std::map<std::string, std::filesystem::path> by_stem;
+  for (const auto& log : in.logs) {
+    if (!in.per_log_dirs) {
+      dirs.push_back(out);
+      continue;
+    }
+    const std::string stem = log.stem().string();
+    const auto [it, fresh] = by_stem.emplace(stem, log);
+    if (!fresh) {
+      throw UsageError("--log: " + it->second.string() + " and " + log.string() +
+                       " would both write " + (out / stem).string() +
+                       "/ (with several logs, each one's outputs go to DIR/<file name without "
+                       ".csv>/): rename one, or replay them separately");
+    }
+    dirs.push_back(out / stem);
+  }
+  return dirs;
+}
+
+// One log's replay; what it prints goes to `console` (a buffer when jobs run in parallel).
+void estimate_log(const EstimatorConfig& config, ReplayOptions replay,
+                  const std::string& description, std::ostream& console) {
+  const ReplayResult r =
+      replay_log(config.robot.model, config.robot.geometry, config.options, replay);
+  console << "extwrench estimate: " << r.rows << " rows -> "
+          << (replay.out_dir / "estimates.csv").string() << "\n";
+  if (r.has_truth) {
+    const sim::Metrics& m = r.report.windows.front().metrics;
+    console << "  metrics (" << description << "), as in `extwrench simulate`:\n"
+            << metrics_header() << metrics_row(replay.name, "-", m, nullptr, NAN);
+    console << "  -> " << (replay.out_dir / "metrics.json").string() << "\n";
+  }
+  for (const auto& f : r.figures) console << "  figure: " << f.string() << "\n";
+  for (const auto& f : r.figure_failures) console << "  figure NOT drawn: " << f << "\n";
+}
+
+// Each log is its own transaction (OutputFiles): a failed log leaves nothing behind, the
+// others' outputs are complete and stay. One log: its error as it is; several: each error was
+// printed in its place, and the command fails naming the failed logs.
+void report_failures(const std::vector<std::filesystem::path>& logs, const JobOutcomes& outcomes,
+                     OutputFiles& top) {
+  if (outcomes.first_failure() == logs.size()) {
+    top.keep();
+    return;
+  }
+  if (logs.size() == 1) std::rethrow_exception(outcomes.errors.front());
+  std::string names;
+  std::size_t failed = 0;
+  for (std::size_t i = 0; i < logs.size(); ++i) {
+    if (!outcomes.errors[i]) continue;
+    ++failed;
+    names += (names.empty() ? "" : ", ") + logs[i].string();
+  }
+  if (failed < logs.size()) top.keep();
+  throw Error(std::to_string(failed) + " of " + std::to_string(logs.size()) +
+              " logs failed (no output for them; the other logs' outputs are complete): " + names);
+}
+
+ReplayOptions replay_options(const EstimateOptions& opt, const std::string& description) {
+  sim::MetricsWindow window{opt.metrics_from, opt.metrics_to, {}};
+  for (const auto& e : opt.exclude) window.exclude.push_back(parse_interval(e));
   ReplayOptions replay;
-  replay.log = opt.log;
-  replay.out_dir = opt.out;
   replay.name = opt.config.stem().string() == "config" && opt.config.has_parent_path()
                     ? opt.config.parent_path().filename().string()
                     : opt.config.stem().string();
@@ -69,27 +154,59 @@ void run_estimate(const EstimateOptions& opt) {
   replay.ignore_extra_joint_columns = opt.ignore_extra_joints;
   replay.plot_points = opt.plot_points;
   replay.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere
+  return replay;
+}
+
+void run_estimate(const EstimateOptions& opt) {
+  std::string description = "t >= " + format_number(opt.metrics_from) + " s";
+  for (const auto& e : opt.exclude) description += ", excluding [" + e + "] s";
+  const ReplayOptions common = replay_options(opt, description);  // checks --exclude
+  if (!(opt.plot_points >= 10)) throw UsageError("--plot-points must be at least 10");
+  const LogInputs inputs = expand_logs(opt.logs);
+  const std::vector<std::filesystem::path> dirs = output_dirs(inputs, opt.out);
+  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  const EstimatorConfig config = load_estimator_config(opt.config, load);
+  for (const auto& log : inputs.logs) check_input_file(log, "log");
   if (config.options.sensor.type != SensorType::kNone) {
     std::cout << "extwrench estimate: base sensor pose X_WS: "
               << pose_summary(config.options.sensor.X_WS) << " (" << config.sensor_pose_source
               << ")\n"
               << std::flush;
   }
-  const ReplayResult r =
-      replay_log(config.robot.model, config.robot.geometry, config.options, replay);
-
-  std::cout << "extwrench estimate: " << r.rows << " rows -> "
-            << (opt.out / "estimates.csv").string() << "\n";
-  if (r.has_truth) {
-    const sim::Metrics& m = r.report.windows.front().metrics;
-    std::cout << "  metrics (" << description << "), as in `extwrench simulate`:\n" << std::flush;
-    print_metrics_header();
-    print_metrics_row(replay.name, "-", m, nullptr, NAN);
-    std::fflush(stdout);
-    std::cout << "  -> " << (opt.out / "metrics.json").string() << "\n";
-  }
-  for (const auto& f : r.figures) std::cout << "  figure: " << f.string() << "\n";
-  for (const auto& f : r.figure_failures) std::cout << "  figure NOT drawn: " << f << "\n";
+  const std::size_t count = inputs.logs.size();
+  // Jobs = whole replays, each its own three-thread pipeline (reader, estimator, writer;
+  // app/replay.hpp): --jobs N runs N replays at once. A replay's reader and writer already keep
+  // about a second core busy and yield to its estimator (nice), so N replays need no further
+  // split of the cores: the kernel shares them among the 3N threads, none of which spins.
+  const bool serial = opt.jobs == 1 || count == 1;
+  std::vector<std::ostringstream> messages(count), printed(count);
+  OutputFiles top;  // DIR itself, removed again if every log fails
+  if (inputs.per_log_dirs) top.create_directories(opt.out);
+  const JobOutcomes outcomes = run_jobs(
+      count,
+      [&](std::size_t i) {
+        ReplayOptions replay = common;
+        replay.log = inputs.logs[i];
+        replay.out_dir = dirs[i];
+        replay.progress = serial;  // parallel progress lines would overwrite one another
+        if (count == 1) return estimate_log(config, std::move(replay), description, std::cout);
+        replay.messages = &messages[i];
+        try {
+          estimate_log(config, std::move(replay), description, printed[i]);
+        } catch (const std::exception& e) {
+          messages[i] << "extwrench: error: " << e.what() << "\n";
+          throw;
+        }
+      },
+      {.jobs = opt.jobs},
+      [&](std::size_t i) {
+        // The replay's notes and warnings name its scheme, not its log: say which log.
+        if (!messages[i].str().empty())
+          std::cerr << "extwrench: " << inputs.logs[i].string() << ":\n" << messages[i].str();
+        std::cerr << std::flush;
+        std::cout << printed[i].str() << std::flush;
+      });
+  report_failures(inputs.logs, outcomes, top);
 }
 
 }  // namespace
@@ -98,15 +215,19 @@ void register_estimate(CLI::App& app) {
   auto opt = std::make_shared<EstimateOptions>();
   CLI::App* sub = app.add_subcommand(
       "estimate",
-      "Replay a robot log through the contact estimator: estimates.csv, and with truth columns "
-      "metrics.json; PNG figures (docs/log_format.md)");
+      "Replay robot logs through the contact estimator: estimates.csv, and with truth columns "
+      "metrics.json; PNG figures (docs/log_format.md). Several logs run in parallel (--jobs)");
   sub->add_option("--config", opt->config, "Estimator configuration (YAML, docs/config.md)")
       ->required()
       ->type_name("CONFIG.yaml");
-  sub->add_option("--log", opt->log, "Robot log (CSV, docs/log_format.md)")
+  sub->add_option("--log", opt->logs,
+                  "Robot log(s) (CSV, docs/log_format.md): repeatable, several after one --log, "
+                  "or a quoted pattern such as 'logs/*.csv'. One log: DIR/estimates.csv...; "
+                  "several (or a pattern): DIR/<log file name without .csv>/estimates.csv...")
       ->required()
       ->type_name("LOG.csv");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
+  add_jobs_option(*sub, opt->jobs, "Logs replayed");
   sub->add_option("--metrics-from", opt->metrics_from,
                   "Start of the metrics window [s] (default 0.2, after the residual's transient, "
                   "as simulate)")

@@ -29,6 +29,8 @@ Examples:
       the paper's experiment: closed-loop simulation, then every estimator scheme on its log
   extwrench estimate --config scheme.yaml --log log.csv --out results/replay
       replay a recorded (or simulated) log through the contact estimator
+  extwrench estimate --config scheme.yaml --log 'logs/*.csv' --out results/sweep --jobs 2
+      every log matching the pattern, two at a time; results/sweep/<log name>/estimates.csv...
   extwrench COMMAND --help
       all options of one command
 

@@ -21,6 +21,7 @@ struct SimulateOptions {
   std::filesystem::path scenario;
   std::filesystem::path out;
   bool no_figures = false;
+  int jobs = 1;
   std::string figure_format = "png";
   std::vector<std::filesystem::path> package_path;
   std::vector<std::string> lock;
@@ -95,7 +96,8 @@ void run_simulate(const SimulateOptions& opt) {
                             : "sensors.base.pose");
   RunOptions run;
   run.figures = !opt.no_figures;
-  run.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere
+  run.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere (--jobs 1)
+  run.jobs = opt.jobs;
   run.figure_format = *parse_figure_format(opt.figure_format);  // checked by CLI11
   RunSummary summary;
   const std::vector<SeedResult> results = run_scenario(scenario, opt.out, run, &summary);
@@ -142,6 +144,7 @@ void register_simulate(CLI::App& app) {
       ->type_name("SCENARIO.yaml");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
   sub->add_flag("--no-figures", opt->no_figures, "Do not draw figures (no gnuplot needed)");
+  add_jobs_option(*sub, opt->jobs, "Seeds simulated, then (seed, scheme) replays,");
   add_figure_format_option(*sub, opt->figure_format);
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);

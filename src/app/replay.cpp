@@ -21,7 +21,11 @@ std::string title_of(const ReplayOptions& o) {
   return o.name.empty() ? std::string("estimate") : o.name;
 }
 
-void note_ignored_columns(const LogReader& reader) {
+std::ostream& messages_of(const ReplayOptions& o) {
+  return o.messages != nullptr ? *o.messages : std::cerr;
+}
+
+void note_ignored_columns(const LogReader& reader, std::ostream& messages) {
   if (reader.ignored_columns().empty()) return;
   // The first few names say enough; a log of 10 000 stray columns must not print them all.
   constexpr std::size_t kShown = 10;
@@ -30,8 +34,8 @@ void note_ignored_columns(const LogReader& reader) {
   for (std::size_t i = 0; i < std::min(ignored.size(), kShown); ++i)
     list += (list.empty() ? "" : ", ") + ignored[i];
   if (ignored.size() > kShown) list += " and " + std::to_string(ignored.size() - kShown) + " more";
-  std::cerr << "extwrench: note: " << reader.name()
-            << ": ignoring columns not in the log format: " << list << "\n";
+  messages << "extwrench: note: " << reader.name()
+           << ": ignoring columns not in the log format: " << list << "\n";
 }
 
 // "q8", "dq8", "tau8", "true_tau_ext8" with 8 > n: a log of another robot, or of this one with
@@ -176,8 +180,8 @@ void draw_figures(const detail::FigureRecorder& figures, const Model& model,
     result.figure_failures.push_back(std::string("figures: ") + x.what());
   }
   for (const std::string& failure : result.figure_failures) {
-    std::cerr << "extwrench: warning: " << fo.title
-              << ": figure not drawn (the estimates stand): " << failure << "\n";
+    messages_of(o) << "extwrench: warning: " << fo.title
+                   << ": figure not drawn (the estimates stand): " << failure << "\n";
   }
 }
 
@@ -201,7 +205,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   LogReader reader(o.log, model);
   const LogLayout layout = reader.layout();  // a copy: the reader moves to its thread
   check_joint_columns(reader, model.nq(), o.ignore_extra_joint_columns);
-  if (o.warn_ignored_columns) note_ignored_columns(reader);
+  if (o.warn_ignored_columns) note_ignored_columns(reader, messages_of(o));
   check_sensor_columns(reader, estimator_options.sensor.type);
   OutputFiles own_outputs;
   OutputFiles& outputs = o.outputs != nullptr ? *o.outputs : own_outputs;
@@ -250,7 +254,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   if (o.figures) draw_figures(*figures, model, geometry, estimator_options, o, outputs, result);
   if (o.warn_disagreement) {
     const std::string warning = disagreement_warning(result);
-    if (!warning.empty()) std::cerr << "extwrench: warning: " << title << ": " << warning << "\n";
+    if (!warning.empty())
+      messages_of(o) << "extwrench: warning: " << title << ": " << warning << "\n";
   }
   own_outputs.keep();
   return result;

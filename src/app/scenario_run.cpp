@@ -3,8 +3,12 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <limits>
+#include <memory>
+#include <sstream>
 
+#include "extwrench/app/jobs.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/io/csv.hpp"
@@ -142,29 +146,38 @@ std::vector<ReplayWindow> metric_windows(const Scenario& s, const SeedResult& r,
   return windows;
 }
 
-// Every scheme replayed on the seed's log.
-void replay_schemes(const Scenario& s, const std::vector<EstimatorConfig>& configs,
-                    const std::vector<ReplayWindow>& windows, const RunOptions& options,
-                    OutputFiles& outputs, SeedResult& r) {
-  for (std::size_t i = 0; i < s.schemes.size(); ++i) {
-    ReplayOptions ro;
-    ro.log = r.dir / "log.csv";
-    ro.out_dir = r.dir / s.schemes[i].name;
-    ro.name = s.schemes[i].name;
-    ro.config_label = (r.dir / s.schemes[i].name / "config.yaml").string();
-    ro.windows = windows;
-    ro.surface_metrics = s.surface_metrics;
-    ro.figures = options.figures && s.figures;
-    ro.figure_format = options.figure_format;
-    ro.desired_trajectory = &s.trajectory;
-    ro.progress = options.progress;
-    ro.warn_ignored_columns = false;
-    ro.outputs = &outputs;
-    // Straight from the files just written, like `extwrench estimate`: nothing else is shared.
-    const EstimatorConfig& cfg = configs[i];
-    r.schemes.push_back(
-        {s.schemes[i].name, replay_log(cfg.robot.model, cfg.robot.geometry, cfg.options, ro)});
-  }
+// A seed between the two phases of a run: its result so far, its schemes' configurations (read
+// back from the files written) and the metric windows of its log.
+struct SeedJob {
+  SeedResult result;
+  std::vector<EstimatorConfig> configs;
+  std::vector<ReplayWindow> windows;
+};
+
+// One scheme replayed on the seed's log, into its own transaction; notes and warnings go to
+// `messages` (the job's buffer).
+SchemeResult replay_scheme(const Scenario& s, const SeedJob& seed, std::size_t scheme,
+                           const RunOptions& options, bool progress, OutputFiles& outputs,
+                           std::ostream& messages) {
+  const SeedResult& r = seed.result;
+  const std::string& name = s.schemes[scheme].name;
+  ReplayOptions ro;
+  ro.log = r.dir / "log.csv";
+  ro.out_dir = r.dir / name;
+  ro.name = name;
+  ro.config_label = (r.dir / name / "config.yaml").string();
+  ro.windows = seed.windows;
+  ro.surface_metrics = s.surface_metrics;
+  ro.figures = options.figures && s.figures;
+  ro.figure_format = options.figure_format;
+  ro.desired_trajectory = &s.trajectory;
+  ro.progress = progress;
+  ro.warn_ignored_columns = false;
+  ro.outputs = &outputs;
+  ro.messages = &messages;
+  // Straight from the files just written, like `extwrench estimate`: nothing else is shared.
+  const EstimatorConfig& cfg = seed.configs[scheme];
+  return {name, replay_log(cfg.robot.model, cfg.robot.geometry, cfg.options, ro)};
 }
 
 std::filesystem::path seed_dir(const Scenario& s, std::uint64_t seed,
@@ -172,21 +185,101 @@ std::filesystem::path seed_dir(const Scenario& s, std::uint64_t seed,
   return s.seeds.size() == 1 ? out_dir : out_dir / ("seed_" + std::to_string(seed));
 }
 
-SeedResult run_seed(const Scenario& s, std::uint64_t seed, const std::filesystem::path& out_dir,
-                    const RunOptions& options, int singular_body, OutputFiles& outputs) {
-  SeedResult r;
-  r.seed = seed;
-  r.dir = seed_dir(s, seed, out_dir);
+// A seed's simulation: its model, configurations and log, and the metric windows they give.
+void simulate_job(const Scenario& s, int singular_body, bool progress, OutputFiles& outputs,
+                  SeedJob& job) {
+  SeedResult& r = job.result;
   outputs.create_directories(r.dir);
   // Two independent streams per seed: the model error and the sensor noise.
-  const Model believed = sim::perturb_model(s.robot.model, s.model_error, 2 * seed);
+  const Model believed = sim::perturb_model(s.robot.model, s.model_error, 2 * r.seed);
   const std::filesystem::path urdf = r.dir / "model_estimator.urdf";
   write_urdf(outputs.stage(urdf), believed, s.robot.geometry);
   outputs.commit(urdf);
-  const std::vector<EstimatorConfig> configs = write_scheme_configs(s, r.dir, outputs);
-  simulate_seed(s, believed, singular_body, options.progress, outputs, r);
-  replay_schemes(s, configs, metric_windows(s, r, singular_body), options, outputs, r);
-  return r;
+  job.configs = write_scheme_configs(s, r.dir, outputs);
+  simulate_seed(s, believed, singular_body, progress, outputs, r);
+  job.windows = metric_windows(s, r, singular_body);
+}
+
+// Rethrows the lowest failing job's error (the one a serial run would have met first), named
+// after its seed (and scheme) when the run has several.
+void rethrow_first_failure(const JobOutcomes& outcomes, const std::string& label) {
+  const std::size_t i = outcomes.first_failure();
+  if (i == outcomes.errors.size()) return;
+  if (label.empty()) std::rethrow_exception(outcomes.errors[i]);
+  try {
+    std::rethrow_exception(outcomes.errors[i]);
+  } catch (const Error& e) {
+    throw Error(label + ": " + e.what());
+  }
+}
+
+// The jobs' own transactions (one per job: OutputFiles is not shared between threads), kept
+// when the whole run succeeds; rolled back last-made first, so that a scheme's files go before
+// the seed directory holding them.
+class JobTransactions {
+ public:
+  JobTransactions() = default;
+  JobTransactions(const JobTransactions&) = delete;
+  JobTransactions& operator=(const JobTransactions&) = delete;
+  ~JobTransactions() {
+    while (!all_.empty()) all_.pop_back();
+  }
+  OutputFiles& add() { return *all_.emplace_back(std::make_unique<OutputFiles>()); }
+  void keep() {
+    for (auto& o : all_) o->keep();
+  }
+
+ private:
+  std::vector<std::unique_ptr<OutputFiles>> all_;
+};
+
+// Every seed's simulation, then every (seed, scheme) replay, each phase on options.jobs threads.
+std::vector<SeedResult> run_jobs_of(const Scenario& s, const std::filesystem::path& out_dir,
+                                    const RunOptions& options, int singular_body,
+                                    JobTransactions& transactions) {
+  const std::size_t n_seeds = s.seeds.size(), n_schemes = s.schemes.size();
+  const JobsOptions jobs{.jobs = options.jobs, .stop_after_failure = true};
+  // Progress lines of parallel jobs would overwrite one another on a terminal.
+  const bool progress = options.progress && options.jobs == 1;
+  std::vector<SeedJob> seeds(n_seeds);
+  std::vector<OutputFiles*> seed_outputs(n_seeds);
+  for (std::size_t i = 0; i < n_seeds; ++i) {
+    seeds[i].result.seed = s.seeds[i];
+    seeds[i].result.dir = seed_dir(s, s.seeds[i], out_dir);
+    seeds[i].result.schemes.resize(n_schemes);
+    seed_outputs[i] = &transactions.add();
+  }
+  const auto seed_label = [&](std::size_t i) {
+    return n_seeds > 1 ? "seed " + std::to_string(s.seeds[i]) : std::string();
+  };
+  const JobOutcomes simulated = run_jobs(
+      n_seeds,
+      [&](std::size_t i) { simulate_job(s, singular_body, progress, *seed_outputs[i], seeds[i]); },
+      jobs);
+  if (const std::size_t failed = simulated.first_failure(); failed < n_seeds)
+    rethrow_first_failure(simulated, seed_label(failed));
+
+  std::vector<OutputFiles*> replay_outputs(n_seeds * n_schemes);
+  std::vector<std::ostringstream> messages(replay_outputs.size());
+  for (auto& o : replay_outputs) o = &transactions.add();
+  std::ostream& console = options.messages != nullptr ? *options.messages : std::cerr;
+  const JobOutcomes replayed = run_jobs(
+      replay_outputs.size(),
+      [&](std::size_t k) {
+        SeedJob& seed = seeds[k / n_schemes];
+        seed.result.schemes[k % n_schemes] = replay_scheme(
+            s, seed, k % n_schemes, options, progress, *replay_outputs[k], messages[k]);
+      },
+      jobs, [&](std::size_t k) { console << messages[k].str() << std::flush; });
+  const std::size_t failed = replayed.first_failure();
+  if (failed < replayed.errors.size()) {
+    const std::string label = seed_label(failed / n_schemes);
+    rethrow_first_failure(replayed, (label.empty() ? "" : label + ", ") + "scheme '" +
+                                        s.schemes[failed % n_schemes].name + "'");
+  }
+  std::vector<SeedResult> results;
+  for (SeedJob& seed : seeds) results.push_back(std::move(seed.result));
+  return results;
 }
 
 }  // namespace
@@ -196,15 +289,18 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
   const Model& model = s.robot.model;
   const int singular_body = s.singularity_link.empty() ? -1 : *model.find_body(s.singularity_link);
   if (!s.seeds.empty()) check_schemes(s, seed_dir(s, s.seeds.front(), out_dir));
-  // One transaction for the whole run: a failure in any seed leaves none of the run's files.
+  if (options.jobs < 1) throw Error("run_scenario: jobs must be at least 1");
+  // One transaction for the whole run, made of the jobs' own: a failure in any seed or scheme
+  // leaves none of the run's files.
   OutputFiles outputs;
-  std::vector<SeedResult> results;
-  for (const std::uint64_t seed : s.seeds)
-    results.push_back(run_seed(s, seed, out_dir, options, singular_body, outputs));
+  if (!s.seeds.empty()) outputs.create_directories(out_dir);
+  JobTransactions transactions;  // after `outputs`: rolled back before it
+  std::vector<SeedResult> results = run_jobs_of(s, out_dir, options, singular_body, transactions);
   if (options.figures && s.figures && results.size() > 1) {
     const auto figure = detail::draw_summary(s, results, out_dir, options.figure_format, outputs);
     if (summary != nullptr && figure) summary->figure = *figure;
   }
+  transactions.keep();
   outputs.keep();
   return results;
 }

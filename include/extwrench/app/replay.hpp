@@ -6,6 +6,7 @@
 #pragma once
 
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,9 @@ struct ReplayOptions {
   bool ignore_extra_joint_columns = false;
   /// Warn on stderr when most contact samples carry `disagreement` (wrong sensor pose...).
   bool warn_disagreement = true;
+  /// Where the notes and warnings go (ignored columns, figures not drawn, disagreement); null:
+  /// std::cerr. Replays running in parallel each get their own buffer, printed in order.
+  std::ostream* messages = nullptr;
   /// The command's output transaction (a scenario run's); null: the replay is its own, kept
   /// when it succeeds. Either way a failed replay leaves no estimates.csv or metrics.json.
   OutputFiles* outputs = nullptr;

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,14 @@ struct SeedResult {
 
 struct RunOptions {
   bool figures = true;
-  bool progress = false;
+  bool progress = false;  ///< progress lines on stderr (only with jobs == 1)
   FigureFormat figure_format = FigureFormat::kPng;
+  /// Seeds simulated, then (seed, scheme) replays run, this many at once (app/jobs.hpp). The
+  /// files and results do not depend on it: each job has its own random streams and files.
+  int jobs = 1;
+  /// The replays' notes and warnings, each replay's together, in (seed, scheme) order; null:
+  /// std::cerr.
+  std::ostream* messages = nullptr;
 };
 
 /// The run's summary across seeds (several seeds, figures on): DIR/summary.<format> with its
@@ -46,6 +53,8 @@ struct RunSummary {
 /// log.csv, model_estimator.urdf, and per scheme <scheme>/config.yaml, estimates.csv,
 /// metrics.json and figures. The estimates come from replaying log.csv through the same code
 /// as `extwrench estimate`, with the configuration read back from <scheme>/config.yaml.
+/// A failure (the lowest failing seed, then scheme: the one a serial run meets first, named
+/// "seed S, scheme 'X': ..." with several seeds) removes every file of the run.
 [[nodiscard]] std::vector<SeedResult> run_scenario(const Scenario& scenario,
                                                    const std::filesystem::path& out_dir,
                                                    const RunOptions& options,
