@@ -239,6 +239,42 @@ void exclude_windows(const std::vector<SuspectWindow>& windows, const std::vecto
       if (samples[k].t >= w.t_begin - kWindowGap && samples[k].t <= w.t_end + settle) use[k] = 0;
 }
 
+/// The fitted friction and offsets into `cal`, and per joint the residual's threshold for the
+/// false-alarm rate, before (r0, the model's own friction) and after the fit.
+void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
+                             const std::vector<JointSeries>& before,
+                             const std::vector<Sample>& samples, const std::vector<char>& use,
+                             const CalibrationOptions& o, Calibration& cal) {
+  const int n = static_cast<int>(fits.size());
+  cal.friction = JointFriction::none(n);
+  cal.friction.sign = o.sign;
+  cal.friction.offset = VectorX::Zero(n);
+  cal.friction.joint_smoothing = VectorX::Zero(n);
+  if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift = VectorX::Zero(n);
+  cal.tau_threshold = VectorX::Zero(n);
+  const double rate = o.false_alarms_per_hour / 3600.0 / n;
+  for (int i = 0; i < n; ++i) {
+    const JointFrictionFit& f = fits[static_cast<std::size_t>(i)];
+    cal.friction.viscous[i] = f.viscous;
+    cal.friction.coulomb[i] = f.coulomb;
+    cal.friction.offset[i] = f.offset;
+    cal.friction.joint_smoothing[i] = f.smoothing;
+    if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift[i] = f.shift;
+    for (const std::string& w : f.warnings) cal.warnings.push_back(w);
+    JointFitReport j;
+    j.condition = f.condition;
+    JointFitReport b;
+    joint_threshold(before[static_cast<std::size_t>(i)].r0, samples, use, rate, 1.0, b);
+    j.rms_before = b.rms_after;
+    j.max_before = b.max_after;
+    joint_threshold(f.residual, samples, use, rate, o.threshold_margin, j);
+    j.variance_explained =
+        b.noise_std > 0 ? 1.0 - (j.noise_std * j.noise_std) / (b.noise_std * b.noise_std) : 0.0;
+    cal.tau_threshold[i] = j.threshold;
+    cal.joints.push_back(j);
+  }
+}
+
 }  // namespace
 
 Calibration calibrate(const Model& model, const EstimatorOptions& options,
@@ -311,33 +347,7 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
         list);
   }
   cal.samples_used = static_cast<int>(std::count(use.begin(), use.end(), 1));
-  cal.friction = JointFriction::none(n);
-  cal.friction.sign = o.sign;
-  cal.friction.offset = VectorX::Zero(n);
-  cal.friction.joint_smoothing = VectorX::Zero(n);
-  if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift = VectorX::Zero(n);
-  cal.tau_threshold = VectorX::Zero(n);
-  const double rate = o.false_alarms_per_hour / 3600.0 / n;
-  for (int i = 0; i < n; ++i) {
-    const JointFrictionFit& f = fits[static_cast<std::size_t>(i)];
-    cal.friction.viscous[i] = f.viscous;
-    cal.friction.coulomb[i] = f.coulomb;
-    cal.friction.offset[i] = f.offset;
-    cal.friction.joint_smoothing[i] = f.smoothing;
-    if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift[i] = f.shift;
-    for (const std::string& w : f.warnings) cal.warnings.push_back(w);
-    JointFitReport j;
-    j.condition = f.condition;
-    JointFitReport b;
-    joint_threshold(before[static_cast<std::size_t>(i)].r0, samples, use, rate, 1.0, b);
-    j.rms_before = b.rms_after;
-    j.max_before = b.max_after;
-    joint_threshold(f.residual, samples, use, rate, o.threshold_margin, j);
-    j.variance_explained =
-        b.noise_std > 0 ? 1.0 - (j.noise_std * j.noise_std) / (b.noise_std * b.noise_std) : 0.0;
-    cal.tau_threshold[i] = j.threshold;
-    cal.joints.push_back(j);
-  }
+  friction_and_thresholds(fits, before, samples, use, o, cal);
   if (options.sensor.type != SensorType::kNone)
     sensor_calibration(model, options, samples, use, o, cal);
   return cal;
