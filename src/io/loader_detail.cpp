@@ -143,14 +143,7 @@ GeometryModel build_geometry(const Model& model, const std::vector<ShapeSpec>& s
   GeometryModel geometry;
   geometry.body_shapes.resize(static_cast<std::size_t>(model.num_bodies()));
   for (const ShapeSpec& spec : shapes) {
-    const auto f = model.find_frame(spec.frame);
-    if (!f) throw Error(spec.source + ": no link or frame named '" + spec.frame + "'");
-    const Frame& frame = model.frames[static_cast<std::size_t>(*f)];
-    CollisionShape shape = spec.shape;
-    shape.link = spec.frame;
-    shape.body = frame.body;
-    // Shapes of links merged by fixed joints move onto the merged body with the link's placement.
-    shape.placement = frame.placement * spec.shape.placement;
+    CollisionShape shape = shape_on_frame(model, spec.shape, spec.frame, spec.source);
     if (shape.type == ShapeType::kMesh) {
       std::string why;
       const auto path = resolve_mesh_path(spec.mesh_uri, base_dir, options, &why);
@@ -170,9 +163,7 @@ GeometryModel build_geometry(const Model& model, const std::vector<ShapeSpec>& s
         shape.mesh = std::move(mesh);
       }
     }
-    geometry.body_shapes[static_cast<std::size_t>(shape.body)].push_back(
-        static_cast<int>(geometry.shapes.size()));
-    geometry.shapes.push_back(std::move(shape));
+    geometry.add(std::move(shape));
   }
   return geometry;
 }

@@ -195,21 +195,13 @@ GeometryModel build_geometry(const mjModel* m, const Model& model,
   geometry.body_shapes.resize(static_cast<std::size_t>(model.num_bodies()));
   std::map<int, std::shared_ptr<const TriangleMesh>> meshes;
   for (const GeomSpec& spec : geoms) {
-    const auto f = model.find_frame(spec.body);
-    if (!f) throw Error(spec.source + ": no link or frame named '" + spec.body + "'");
-    const Frame& frame = model.frames[static_cast<std::size_t>(*f)];
-    CollisionShape shape = spec.shape;
-    shape.link = spec.body;
-    shape.body = frame.body;
-    shape.placement = frame.placement * spec.shape.placement;
+    CollisionShape shape = shape_on_frame(model, spec.shape, spec.body, spec.source);
     if (shape.type == ShapeType::kMesh) {
       auto& mesh = meshes[spec.mesh];
       if (!mesh) mesh = mesh_of(m, spec.mesh, spec.source, options);
       shape.mesh = mesh;
     }
-    geometry.body_shapes[static_cast<std::size_t>(shape.body)].push_back(
-        static_cast<int>(geometry.shapes.size()));
-    geometry.shapes.push_back(std::move(shape));
+    geometry.add(std::move(shape));
   }
   return geometry;
 }

@@ -172,6 +172,18 @@ Pose translation(const Vector3& p) {
   return X;
 }
 
+JointSpec fixed_joint(std::string name, std::string parent, std::string child, const Pose& origin,
+                      std::string source) {
+  JointSpec joint;
+  joint.name = std::move(name);
+  joint.type = JointSpecType::kFixed;
+  joint.parent = std::move(parent);
+  joint.child = std::move(child);
+  joint.origin = origin;
+  joint.source = std::move(source);
+  return joint;
+}
+
 // The joints (or the weld) from `parent_link` to body b's link, as MuJoCo composes them.
 void add_body_joints(const mjModel* m, const std::string& file, int b,
                      const std::string& parent_link, const Pose& X_parent_body,
@@ -179,14 +191,8 @@ void add_body_joints(const mjModel* m, const std::string& file, int b,
   const std::string name = mj::body_name(m, b);
   const int first = m->body_jntadr[b], count = m->body_jntnum[b];
   if (count == 0) {
-    JointSpec weld;
-    weld.name = name + "/weld";
-    weld.type = JointSpecType::kFixed;
-    weld.parent = parent_link;
-    weld.child = name;
-    weld.origin = X_parent_body;
-    weld.source = body_where(m, file, b);
-    builder.add_joint(std::move(weld));
+    builder.add_joint(
+        fixed_joint(name + "/weld", parent_link, name, X_parent_body, body_where(m, file, b)));
     return;
   }
   std::string previous_link = parent_link;
@@ -207,14 +213,8 @@ void add_body_joints(const mjModel* m, const std::string& file, int b,
     builder.add_joint(std::move(spec));
   }
   if (previous_link != name) {
-    JointSpec anchor_to_body;
-    anchor_to_body.name = name + "/anchor";
-    anchor_to_body.type = JointSpecType::kFixed;
-    anchor_to_body.parent = previous_link;
-    anchor_to_body.child = name;
-    anchor_to_body.origin = X_previous_anchor;
-    anchor_to_body.source = body_where(m, file, b);
-    builder.add_joint(std::move(anchor_to_body));
+    builder.add_joint(fixed_joint(name + "/anchor", previous_link, name, X_previous_anchor,
+                                  body_where(m, file, b)));
   }
 }
 

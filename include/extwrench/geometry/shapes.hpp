@@ -43,6 +43,19 @@ struct GeometryModel {
   std::vector<CollisionShape> shapes;
   /// Indices into `shapes` for each body (size = model.num_bodies()).
   std::vector<std::vector<int>> body_shapes;
+
+  /// Appends `shape` and indexes it under its body (body_shapes must already hold that body).
+  void add(CollisionShape shape);
 };
+
+class Model;
+
+/// A shape declared in the frame `frame` of `model` (its placement in that frame's axes) as it
+/// is attached: `link` = frame, `body` = the body carrying the frame, placement composed with
+/// the frame's (shapes of links merged by fixed joints move onto the merged body). Every robot
+/// loader places its shapes through this. Throws Error "<source>: no link or frame named ..."
+/// when the model has no such frame.
+CollisionShape shape_on_frame(const Model& model, const CollisionShape& declared,
+                              const std::string& frame, const std::string& source);
 
 }  // namespace extwrench
