@@ -6,7 +6,8 @@
 #
 # Inputs: BUILD_DIR, CONSUMER_DIR, WORK_DIR, CXX_COMPILER, SANITIZE (ON when the build uses
 # the sanitizers: the consumer must then link their runtimes too), HAVE_CLI (1 when the
-# extwrench binary is built).
+# extwrench binary is built), HAVE_MUJOCO (1 when extwrench::mujoco is built: its component is
+# then installed and a fourth consumer loads the installed MJCF robot through it).
 foreach(var BUILD_DIR CONSUMER_DIR WORK_DIR CXX_COMPILER)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_packaging_test.cmake: ${var} is not set")
@@ -34,6 +35,12 @@ set(expected include/extwrench/dynamics/rnea.hpp include/extwrench/io/csv.hpp
 if(HAVE_CLI)
   list(APPEND expected bin/extwrench)
 endif()
+if(HAVE_MUJOCO)
+  list(APPEND expected include/extwrench/bridges/mjcf.hpp include/extwrench/bridges/mujoco.hpp
+       share/extwrench/models/paper_arm.xml)
+else()
+  set(HAVE_MUJOCO 0)
+endif()
 foreach(f ${expected})
   if(NOT EXISTS ${prefix}/${f})
     message(FATAL_ERROR "packaging test: ${f} is not installed")
@@ -51,12 +58,15 @@ if(SANITIZE)
 endif()
 run_step("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${consumer_build}
          -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
-         -DCMAKE_BUILD_TYPE=Release ${flags})
+         -DCMAKE_BUILD_TYPE=Release -DEXTWRENCH_CONSUMER_MUJOCO=${HAVE_MUJOCO} ${flags})
 run_step("build the consumer" ${CMAKE_COMMAND} --build ${consumer_build} --parallel 2)
 run_step("core-only consumer" ${consumer_build}/core/consumer_core)
 run_step("io consumer on the installed URDF" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.urdf)
 run_step("io consumer on the installed DH table" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.yaml)
 run_step("app consumer (replay_log)" ${consumer_build}/app/consumer_app ${prefix}/share/extwrench/models/paper_arm.urdf ${WORK_DIR}/app_out)
+if(HAVE_MUJOCO)
+  run_step("mujoco consumer on the installed MJCF" ${consumer_build}/mujoco/consumer_mujoco ${prefix}/share/extwrench/models/paper_arm.xml)
+endif()
 if(HAVE_CLI)
   run_step("installed CLI" ${prefix}/bin/extwrench info ${prefix}/share/extwrench/models/paper_arm.yaml)
 endif()
