@@ -48,7 +48,7 @@ struct GeometryModel {
   void add(CollisionShape shape);
 };
 
-class Model;
+struct Model;
 
 /// A shape declared in the frame `frame` of `model` (its placement in that frame's axes) as it
 /// is attached: `link` = frame, `body` = the body carrying the frame, placement composed with
