@@ -43,10 +43,22 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
   Vector3 w_dot = Vector3::Zero();
   detail::joint_sin_cos(model, data, q);
   for (int i = 1; i < nb; ++i) {
+    const int p = model.parents[i];
+    if (p != i - 1) {
+      X_parent = data.X_WB[p];
+      v_O = data.v[p].head<3>();
+      w = data.v[p].tail<3>();
+      if constexpr (full) {
+        a_O = data.a[p].head<3>();
+        w_dot = data.a[p].tail<3>();
+      }
+    }
     Matrix3 R;
-    Vector3 O, s_lin, s_ang;  // body i's pose and motion subspace
-    detail::forward_step<full>(model, data, i, q[i - 1], dq[i - 1], 0.0, X_parent, v_O, w, a_O,
-                               w_dot, R, O, s_lin, s_ang);
+    Vector3 O;
+    Vector3 s_lin;
+    Vector3 s_ang;
+    detail::joint_kinematics(model, data, i, X_parent, q[i - 1], R, O, s_lin, s_ang);
+    detail::propagate_motion<full>(s_lin, s_ang, dq[i - 1], 0.0, v_O, w, a_O, w_dot);
     const Inertia& inertia = model.bodies[i].inertia;
     const Vector3 c = R * inertia.com + O;
     // h_i about the world origin: [m v_c; I_c,W w + c x m v_c], v_c the velocity of the CoM.
@@ -55,7 +67,12 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
     const Vector3 w_B = R.transpose() * w;
     const Vector3 Iw_B = inertia.inertia_com * w_B;
     const Vector3 K = R * Iw_B + c.cross(L);  // I_c,W w + c x L
-    detail::store_pose_and_velocity(data, i, R, O, s_lin, s_ang, v_O, w);
+    data.X_WB[i].rotation = R;
+    data.X_WB[i].translation = O;
+    data.S[i].head<3>() = s_lin;
+    data.S[i].tail<3>() = s_ang;
+    data.v[i].head<3>() = v_O;
+    data.v[i].tail<3>() = w;
     data.h[i].head<3>() = L;
     data.h[i].tail<3>() = K;
     data.f[i].head<3>() = L;  // f accumulates H_i = sum of h_k over sub(i) below

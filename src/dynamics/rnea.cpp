@@ -81,10 +81,20 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
   Pose X_parent;  // likewise the parent's pose
   detail::joint_sin_cos(model, data, q);
   for (int i = 1; i < nb; ++i) {
+    const int p = model.parents[i];
+    if (p != i - 1) {
+      X_parent = data.X_WB[p];
+      v_O = data.v[p].head<3>();
+      w = data.v[p].tail<3>();
+      a_O = data.a[p].head<3>();
+      w_dot = data.a[p].tail<3>();
+    }
     Matrix3 R;
-    Vector3 O, s_lin, s_ang;  // body i's pose and motion subspace
-    detail::forward_step<true>(model, data, i, q[i - 1], dq[i - 1], ddq[i - 1], X_parent, v_O, w,
-                               a_O, w_dot, R, O, s_lin, s_ang);
+    Vector3 O;
+    Vector3 s_lin;
+    Vector3 s_ang;
+    detail::joint_kinematics(model, data, i, X_parent, q[i - 1], R, O, s_lin, s_ang);
+    detail::propagate_motion<true>(s_lin, s_ang, dq[i - 1], ddq[i - 1], v_O, w, a_O, w_dot);
     const Inertia& inertia = model.bodies[i].inertia;
     const Vector3 c = R * inertia.com + O;
     const Vector3 v_c = v_O + w.cross(c);
@@ -93,7 +103,12 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
     Vector3 N;
     detail::newton_euler_about_com(inertia, R, c, v_c, w, a_O, w_dot, w_B,
                                    inertia.inertia_com * w_B, F, N);
-    detail::store_pose_and_velocity(data, i, R, O, s_lin, s_ang, v_O, w);
+    data.X_WB[i].rotation = R;
+    data.X_WB[i].translation = O;
+    data.S[i].head<3>() = s_lin;
+    data.S[i].tail<3>() = s_ang;
+    data.v[i].head<3>() = v_O;
+    data.v[i].tail<3>() = w;
     data.a[i].head<3>() = a_O;
     data.a[i].tail<3>() = w_dot;
     data.f[i].head<3>() = F;

@@ -171,46 +171,6 @@ template <bool with_acceleration>
   w += vj_ang;
 }
 
-/// One step of a forward pass, from body i's parent to body i: body i's pose (R, O) and motion
-/// subspace [s_lin; s_ang], and the motion [v_O; w] (and, with `with_acceleration`,
-/// [a_O; w_dot]) advanced in place from the parent's to body i's. Along a chain the parent's pose
-/// X_WP and motion are the caller's registers (body i - 1); at a branching of a tree they are
-/// reloaded from data. (Out-parameters, not a returned struct: the struct kept R and O on the
-/// stack in both passes.)
-template <bool with_acceleration>
-[[gnu::always_inline]] inline void forward_step(const Model& model, const Data& data, int i,
-                                                double qi, double qd, double qdd, Pose& X_WP,
-                                                Vector3& v_O, Vector3& w, Vector3& a_O,
-                                                Vector3& w_dot, Matrix3& R, Vector3& O,
-                                                Vector3& s_lin, Vector3& s_ang) {
-  const int p = model.parents[i];
-  if (p != i - 1) {
-    X_WP = data.X_WB[p];
-    v_O = data.v[p].head<3>();
-    w = data.v[p].tail<3>();
-    if constexpr (with_acceleration) {
-      a_O = data.a[p].head<3>();
-      w_dot = data.a[p].tail<3>();
-    }
-  }
-  joint_kinematics(model, data, i, X_WP, qi, R, O, s_lin, s_ang);
-  propagate_motion<with_acceleration>(s_lin, s_ang, qd, qdd, v_O, w, a_O, w_dot);
-}
-
-/// Body i's pose (R, O), motion subspace [s_lin; s_ang] and velocity [v_O; w], kept in
-/// registers by the forward passes, stored once into data.
-[[gnu::always_inline]] inline void store_pose_and_velocity(Data& data, int i, const Matrix3& R,
-                                                           const Vector3& O, const Vector3& s_lin,
-                                                           const Vector3& s_ang, const Vector3& v_O,
-                                                           const Vector3& w) {
-  data.X_WB[i].rotation = R;
-  data.X_WB[i].translation = O;
-  data.S[i].head<3>() = s_lin;
-  data.S[i].tail<3>() = s_ang;
-  data.v[i].head<3>() = v_O;
-  data.v[i].tail<3>() = w;
-}
-
 /// Eqs. (7)-(8) for one body about its CoM c (world), with the constant body-axes inertia I_c so
 /// that no world inertia R I_c R^T is formed: F = m c_ddot, N_c = R (I_c w_dot_B + w_B x I_c w_B),
 /// moved to the world origin: [F; N] = [F; N_c + c x F] (= I_i a_i + v_i x* I_i v_i). c_ddot =
