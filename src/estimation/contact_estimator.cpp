@@ -467,10 +467,8 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
 // than the residual's transient. Out: kDisagreement in `flags`.
 void ContactEstimator::consistency(double t, int link, bool contact, const WrenchFit& fit,
                                    std::uint32_t& flags) noexcept {
-  const bool inconsistent =
-      contact && fit.ok && !fit.damped && link > 0 &&
-      contradicts_residual(J_, fit, tau_ext_, detector_.tau_min(), tau_pred_,
-                           options_.contact.model == ContactModel::kPureForce);
+  const bool inconsistent = contact && fit.ok && !fit.damped && link > 0 &&
+                            contradicts_residual(J_, fit, tau_ext_, detector_.tau_min(), tau_pred_);
   if (inconsistent) {
     if (!have_disagreement_edge_) {
       have_disagreement_edge_ = true;

@@ -13,14 +13,12 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// True when the pure force F̂ along the fit's line of action (moment about O_l
-/// pure_force_moment: M̄ without its component along F̂) reproduces τ̂_ext on every joint within
-/// its tolerance (zero torque expected beyond the candidate: J is zero there). With M̄ itself, a
-/// link with six joints before it would fit any residual exactly and always be consistent.
+/// True when the single wrench (F̂, M̄) on the candidate reproduces τ̂_ext on every joint within
+/// its tolerance (zero torque expected beyond the candidate: J is zero there).
 bool predicts_residual(const Matrix6X& J, const WrenchFit& fit, const VectorX& tau_ext,
                        const VectorX& tolerance, VectorX& tau_pred) noexcept {
   Vector6 w;
-  w << fit.force_W, pure_force_moment(fit);
+  w << fit.force_W, fit.moment_O;
   tau_pred.noalias() = J.transpose() * w;
   for (Eigen::Index i = 0; i < tau_pred.size(); ++i) {
     if (!(std::abs(tau_pred[i] - tau_ext[i]) <= tolerance[i])) return false;

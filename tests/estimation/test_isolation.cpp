@@ -10,7 +10,6 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/estimation/isolation.hpp"
-#include "extwrench/estimation/wrench_cases.hpp"
 #include "extwrench/io/robot_loader.hpp"
 
 namespace extwrench {
@@ -58,19 +57,6 @@ TEST(Isolation, WithoutASensorAChoiceAboveALinkThatCannotBeTestedIsFlaggedAmbigu
   }
   // The case of the issue: some of these configurations choose a link above.
   EXPECT_GT(decided, 0);
-}
-
-TEST(Isolation, ThePureForceMomentDropsTheMomentAlongTheForce) {
-  WrenchFit fit;
-  fit.force_W = Vector3(0.0, 0.0, 5.0);
-  fit.moment_O = Vector3(1.0, -2.0, 3.0);
-  EXPECT_TRUE(pure_force_moment(fit).isApprox(Vector3(1.0, -2.0, 0.0)));
-  // It is the moment about O_l of the force along the line of action (19)-(21).
-  Vector3 p_W, u_W;
-  ASSERT_TRUE(line_of_action(fit, Vector3::Zero(), p_W, u_W));
-  EXPECT_TRUE(p_W.cross(fit.force_W).isApprox(pure_force_moment(fit)));
-  fit.force_W.setZero();
-  EXPECT_EQ(pure_force_moment(fit), fit.moment_O);
 }
 
 }  // namespace

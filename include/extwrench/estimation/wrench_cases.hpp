@@ -131,28 +131,15 @@ template <typename Jacobian>
   return true;
 }
 
-/// The moment about O_l of the pure force F̂ along the line of action (19)–(21):
-/// (p̂ − O_l) × F̂ = M̄ − (M̄·u) u, u = F̂/‖F̂‖. A fitted M̄ with a component along F̂ (a wrench
-/// with pitch) is no pure force: judged on this moment, that component counts against the fit.
-/// M̄ itself when ‖F̂‖ is 0 or not finite.
-[[nodiscard]] inline Vector3 pure_force_moment(const WrenchFit& fit) noexcept {
-  const Vector3& F = fit.force_W;
-  const double f2 = F.squaredNorm();
-  if (!(f2 > 0.0 && std::isfinite(f2))) return fit.moment_O;
-  return fit.moment_O - (fit.moment_O.dot(F) / f2) * F;
-}
-
 /// Consistency: a single wrench on link l must reproduce τ̂_ext = J_lᵀ (F̂, M̄) on every joint
-/// within τ_min; for a pure-force contact (`pure_force`) the wrench is the force along its line,
-/// (F̂, pure_force_moment). In: J = J_l, the fit, τ̂_ext, τ_min (n). Scratch: tau_pred (n). True
-/// when some joint differs by more than its τ_min (two contacts, a contact on another link, or
-/// a fit that needs a moment along the force).
+/// within τ_min. In: J = J_l, the fit, τ̂_ext, τ_min (n). Scratch: tau_pred (n). True when some
+/// joint differs by more than its τ_min (two contacts, or a contact on another link).
 template <typename Jacobian>
 [[nodiscard]] inline bool contradicts_residual(const Jacobian& J, const WrenchFit& fit,
                                                const VectorX& tau_ext, const VectorX& tau_min,
-                                               VectorX& tau_pred, bool pure_force) noexcept {
+                                               VectorX& tau_pred) noexcept {
   Vector6 w;
-  w << fit.force_W, (pure_force ? pure_force_moment(fit) : fit.moment_O);
+  w << fit.force_W, fit.moment_O;
   tau_pred.noalias() = J.transpose() * w;
   bool inconsistent = false;
   for (Eigen::Index i = 0; i < tau_pred.size(); ++i) {
