@@ -1,4 +1,5 @@
 // extwrench: the command-line tool. Subcommands live one per file (commands.hpp).
+#include <cstdio>
 #include <exception>
 #include <iostream>
 
@@ -79,6 +80,13 @@ int main(int argc, char** argv) {
     return kExitInputError;
   } catch (const std::exception& e) {
     std::cerr << "extwrench: error: " << e.what() << "\n";
+    return kExitInputError;
+  }
+  // What the command printed must have reached stdout: `info > /dev/full` (a full disk) is a
+  // failure, not a success whose output was lost.
+  std::cout.flush();
+  if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout) != 0) {
+    std::cerr << "extwrench: error: <stdout>: write failed (disk full or file removed?)\n";
     return kExitInputError;
   }
   return 0;

@@ -44,7 +44,9 @@ std::string cell(double v, const char* format) {
 // One row per seed, the worst over the seeds, and the scenario's targets for the scheme.
 void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
                   const std::vector<SeedResult>& results) {
-  double worst_f = 0.0, worst_f_outside = 0.0, worst_line = 0.0, worst_link = 1.0;
+  // NaN (printed '-') until a seed has the window: a scenario without a singularity window has
+  // no 'F RMS*', and its worst is not 0.
+  double worst_f = 0.0, worst_f_outside = NAN, worst_line = 0.0, worst_link = 1.0;
   for (const SeedResult& r : results) {
     for (const SchemeResult& sr : r.schemes) {
       if (sr.name != scheme.name) continue;
@@ -52,10 +54,11 @@ void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
       const NamedMetrics* b = window_named(sr.replay, "outside_singularity");
       if (!a) continue;
       const sim::Metrics& m = a->metrics;
+      // The peak of cond(J of O_l) is tracked only for a singularity window's link.
       print_metrics_row(scheme.name, std::to_string(r.seed), m, b ? &b->metrics : nullptr,
-                        r.peak_condition);
+                        scenario.singularity_link.empty() ? NAN : r.peak_condition);
       worst_f = std::max(worst_f, m.force.rms());
-      if (b) worst_f_outside = std::max(worst_f_outside, b->metrics.force.rms());
+      if (b) worst_f_outside = std::fmax(worst_f_outside, b->metrics.force.rms());
       if (m.line.count > 0) worst_line = std::max(worst_line, m.line.rms());
       worst_link = std::min(worst_link, m.isolation_accuracy());
     }
@@ -107,11 +110,18 @@ void run_simulate(const SimulateOptions& opt) {
       opt.scenario.string().c_str(), results.size(), scenario.simulation.duration,
       1e3 * scenario.simulation.sample_time, 100.0 * scenario.model_error);
   const std::string from = cell(scenario.metrics_from, "%g");
-  std::printf(
-      "Metrics after t = %s s; 'F RMS*' excludes ±%g s around every crossing of cond(J of O_l) > "
-      "%g, l = %s.\n\n",
-      from.c_str(), scenario.singularity_half_width, scenario.singularity_threshold,
-      scenario.singularity_link.empty() ? "-" : scenario.singularity_link.c_str());
+  if (scenario.singularity_half_width > 0.0) {
+    std::printf(
+        "Metrics after t = %s s; 'F RMS*' excludes ±%g s around every crossing of cond(J of O_l) "
+        "> %g, l = %s.\n\n",
+        from.c_str(), scenario.singularity_half_width, scenario.singularity_threshold,
+        scenario.singularity_link.c_str());
+  } else {
+    std::printf(
+        "Metrics after t = %s s; no singularity window ('F RMS*', 'peak cond': "
+        "metrics.exclude_around_singularity).\n\n",
+        from.c_str());
+  }
   print_metrics_header();
   for (const SchemeSpec& scheme : scenario.schemes) print_scheme(scenario, scheme, results);
   std::printf(

@@ -168,6 +168,9 @@ std::string condition_script(const PlotContext& c, const Figure& f, const Envelo
   if (max_condition > 0.0) {
     extra = ", " + std::to_string(max_condition) +
             " with lines lw 1.5 dt 3 lc rgb 'black' title 'damping threshold'";
+    // The threshold inside the frame, not on its top edge (the autoscaled top was often the
+    // threshold itself): an undrawn line at 3 × the threshold raises the autoscaled top.
+    extra += ", " + std::to_string(3.0 * max_condition) + " with lines lt nodraw notitle";
   }
   if (!spans.empty())
     extra +=

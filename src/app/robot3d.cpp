@@ -228,9 +228,10 @@ std::string robot3d_script(const PlotContext& c, const Figure& f, const Robot3dI
     std::snprintf(arrow, sizeof arrow, "estimated force (%.2g m = %.3g N)", kArrowLength,
                   kArrowLength / scale);
   // Each view in a cell of its own (origin and size set per view), the title in a band at the
-  // top, the key in a band on the right: nothing overlaps.
+  // top, the key in a band on the right: nothing overlaps. The views start a little right of
+  // the canvas's edge: the left column's z label is drawn left of its axis and was cut off.
   const int height = 480 * lines + 40;
-  const double top = 40.0 / height, views_width = 0.78;
+  const double top = 40.0 / height, left = 0.025, views_width = 0.76;
   const double cell_w = views_width / cols, cell_h = (1.0 - top) / lines;
   s << gnuplot_preamble(f.output, c.format, 1350, height) << "set multiplot title "
     << gnuplot_quote("Robot (collision shapes), estimated force, line of action and points — " +
@@ -256,8 +257,8 @@ std::string robot3d_script(const PlotContext& c, const Figure& f, const Robot3dI
     };
     const int i = kBlocks * static_cast<int>(k);
     const int row = static_cast<int>(k) / cols, column = static_cast<int>(k) % cols;
-    s << "set origin " << column * cell_w << ", " << 1.0 - top - (row + 1) * cell_h << "\nset size "
-      << cell_w << ", " << cell_h << "\nset title '" << t << "'\n"
+    s << "set origin " << left + column * cell_w << ", " << 1.0 - top - (row + 1) * cell_h
+      << "\nset size " << cell_w << ", " << cell_h << "\nset title '" << t << "'\n"
       << "splot 'robot3d.txt' index " << i
       << " with linespoints lw 3 pt 7 ps 0.8 lc rgb '#555555' title "
       << title("links (sensor, joint origins)") << ", '' index " << i + 1

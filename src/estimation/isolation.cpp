@@ -34,7 +34,8 @@ struct CandidateHit {
 
 CandidateHit test_candidate(const Model& model, const Data& data, const GeometryModel& geometry,
                             int l, const IsolationInputs& in, const SolverOptions& solver,
-                            IsolationWorkspace& ws, bool& consistent) noexcept {
+                            IsolationWorkspace& ws, bool& testable, bool& consistent) noexcept {
+  testable = false;
   consistent = false;
   CandidateHit out;
   const Pose& X_WL = data.X_WB[static_cast<std::size_t>(l)];
@@ -42,7 +43,9 @@ CandidateHit test_candidate(const Model& model, const Data& data, const Geometry
   point_jacobian(model, data, l, O_l, ws.J);
   const WrenchFit fit = wrench_case(in.sensor, ws.J, l, *in.tau_ext, *in.base, O_l, in.p_WS, solver,
                                     ws.b, ws.guess[static_cast<std::size_t>(l)], false);
-  if (!fit.ok || !predicts_residual(ws.J, fit, *in.tau_ext, ws.tolerance, ws.tau_pred)) return out;
+  if (!fit.ok) return out;
+  testable = true;
+  if (!predicts_residual(ws.J, fit, *in.tau_ext, ws.tolerance, ws.tau_pred)) return out;
   Vector3 p_W, u_W;
   if (!line_of_action(fit, O_l, p_W, u_W)) return out;
   consistent = true;
@@ -97,11 +100,16 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   int best_link = -1;
   // Abscissae of the consistent hits, to judge ambiguity once the best is known.
   double abscissa[64];
+  // The lowest candidate with shapes whose case is not observable (it could hold the contact but
+  // cannot be tested: without a sensor, a link with fewer than six joints before it).
+  int lowest_untested = last + 1;
   for (int l = in.residual_link; l <= last; ++l) {
     abscissa[l] = kInf;
     if (geometry.body_shapes[static_cast<std::size_t>(l)].empty()) continue;
-    bool consistent = false;
-    const CandidateHit c = test_candidate(model, data, geometry, l, in, solver, ws, consistent);
+    bool testable = false, consistent = false;
+    const CandidateHit c =
+        test_candidate(model, data, geometry, l, in, solver, ws, testable, consistent);
+    if (!testable) lowest_untested = std::min(lowest_untested, l);
     if (!consistent) continue;
     res.candidates |= std::uint64_t{1} << l;
     if (c.hit) {
@@ -120,6 +128,9 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
     if (l != best_link && abscissa[l] - best.abscissa <= options.ambiguity_distance)
       res.ambiguous = true;
   }
+  // A link below the chosen one could not be tested: it may hold the contact as well (a push on
+  // the paper arm's link 4 without a sensor fits a force on link 6 within tolerance).
+  if (lowest_untested < best_link) res.ambiguous = true;
   return res;
 }
 

@@ -61,6 +61,22 @@ run_step("configure the consumer" ${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${consu
          -DCMAKE_BUILD_TYPE=Release -DEXTWRENCH_CONSUMER_MUJOCO=${HAVE_MUJOCO} ${flags})
 run_step("build the consumer" ${CMAKE_COMMAND} --build ${consumer_build} --parallel 2)
 run_step("core-only consumer" ${consumer_build}/core/consumer_core)
+# The core as on a machine with Eigen alone: every other dependency's find_package disabled (a
+# REQUIRED find_dependency of a disabled package is an error), the core consumer on its own.
+set(core_only ${WORK_DIR}/core-only)
+file(MAKE_DIRECTORY ${core_only})
+file(WRITE ${core_only}/CMakeLists.txt
+     "cmake_minimum_required(VERSION 3.22)\nproject(core_only LANGUAGES CXX)\n"
+     "set(CMAKE_CXX_STANDARD 20)\nadd_subdirectory(${CONSUMER_DIR}/core core)\n")
+set(disabled "")
+foreach(p yaml-cpp tinyxml2 assimp embree Threads mujoco)
+  list(APPEND disabled -DCMAKE_DISABLE_FIND_PACKAGE_${p}=ON)
+endforeach()
+run_step("configure the core consumer with only Eigen findable" ${CMAKE_COMMAND} -S ${core_only}
+         -B ${core_only}/build -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+         -DCMAKE_BUILD_TYPE=Release ${flags} ${disabled})
+run_step("build the core consumer with only Eigen findable" ${CMAKE_COMMAND} --build
+         ${core_only}/build)
 run_step("io consumer on the installed URDF" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.urdf)
 run_step("io consumer on the installed DH table" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.yaml)
 run_step("app consumer (replay_log)" ${consumer_build}/app/consumer_app ${prefix}/share/extwrench/models/paper_arm.urdf ${WORK_DIR}/app_out)

@@ -247,6 +247,62 @@ TEST_F(Hostile, EstimateFailingOnALateRowLeavesNoEstimates) {
   EXPECT_EQ(listing(path("out")), "(no directory)");
 }
 
+TEST_F(Hostile, DynamicsAndCalibrateFailingOnALateRowLeaveNoOutput) {
+  std::string states = "t";
+  for (const char* group : {"q", "dq", "ddq"})
+    for (int i = 1; i <= 7; ++i) states += "," + std::string(group) + std::to_string(i);
+  states += "\n";
+  for (int k = 0; k < 50'000; ++k) {
+    states += std::to_string(0.001 * k);
+    for (int i = 0; i < 21; ++i) states += ",0.1";
+    states += "\n";
+  }
+  write_text(path("states.csv"), states + "oops\n");
+  const CliRun d = run("dynamics --robot " + q(kPaperArm) + " --in " + q(path("states.csv")) +
+                           " --out " + q(path("out/predicted.csv")),
+                       "mkdir -p " + q(path("out")) + ";");
+  EXPECT_EQ(d.code, 1);
+  EXPECT_TRUE(contains(d.err, "states.csv:50002:"));
+  EXPECT_EQ(listing(path("out")), "");  // neither predicted.csv nor predicted.csv.partial
+  write_log(path("log.csv"), 50'000);
+  std::ofstream(path("log.csv"), std::ios::app) << "oops\n";
+  write_text(path("config.yaml"), "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  const CliRun c = run("calibrate --config " + q(path("config.yaml")) + " --log " +
+                       q(path("log.csv")) + " --out " + q(path("out/calib.yaml")));
+  EXPECT_EQ(c.code, 1);
+  EXPECT_TRUE(contains(c.err, "log.csv:50002:"));
+  EXPECT_EQ(listing(path("out")), "");
+}
+
+TEST_F(Hostile, OutputToAFullDeviceIsAnErrorNotASuccess) {
+  // stdout on /dev/full: what the command printed is lost, so it must not exit 0.
+  if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+  write_text(path("states.csv"),
+             "t,q1,q2,q3,q4,q5,q6,q7,dq1,dq2,dq3,dq4,dq5,dq6,dq7,ddq1,ddq2,ddq3,"
+             "ddq4,ddq5,ddq6,ddq7\n0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n");
+  for (const std::string& args :
+       {"info " + q(kPaperArm),
+        "dynamics --robot " + q(kPaperArm) + " --in " + q(path("states.csv")) + " --out -"}) {
+    const std::string command =
+        "'" + std::string(cli_binary()) + "' " + args + " >/dev/full 2>" + q(path("stderr.txt"));
+    const int status = std::system(command.c_str());
+    ASSERT_TRUE(WIFEXITED(status)) << args;
+    EXPECT_EQ(WEXITSTATUS(status), 1) << args;
+    EXPECT_TRUE(contains(read_text(path("stderr.txt")), "<stdout>: write failed")) << args;
+  }
+}
+
+TEST_F(Hostile, AnInvalidConfigurationOfEstimateIsRejectedBeforeAnythingIsWritten) {
+  write_log(path("log.csv"), 1'000);
+  write_text(path("config.yaml"),
+             "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\ncontact: {model: magic}\n");
+  const CliRun r = run("estimate --config " + q(path("config.yaml")) + " --log " +
+                       q(path("log.csv")) + " --out " + q(path("out")));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_TRUE(contains(r.err, "contact.model"));
+  EXPECT_EQ(listing(path("out")), "(no directory)");
+}
+
 TEST_F(Hostile, AFullDiskDuringEstimateOrSimulateLeavesNoTruncatedFile) {
   // RLIMIT_FSIZE stands for a full disk: writes past 1 MiB fail (SIGXFSZ ignored).
   const std::string full = "ulimit -f 1024; trap '' XFSZ;";

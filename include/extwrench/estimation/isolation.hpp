@@ -8,7 +8,8 @@
 //  - its line of action must meet l's collision shapes.
 // Among the consistent candidates the contact is where a pusher coming along the line first
 // meets the arm: the smallest entry abscissa u·p over the candidates' shapes. Two candidates
-// whose entries lie within ambiguity_distance of each other are equally good: kAmbiguous.
+// whose entries lie within ambiguity_distance of each other are equally good: kAmbiguous; so is
+// a choice above a candidate that could not be tested (its case not observable).
 // Real time: noexcept, no allocation (the workspace is sized once).
 #pragma once
 
@@ -54,7 +55,8 @@ struct IsolationWorkspace {
 struct IsolationResult {
   int link = -1;                 ///< the chosen link
   std::uint64_t candidates = 0;  ///< bit l: link l consistent (the chosen one included)
-  bool ambiguous = false;        ///< another consistent entry within ambiguity_distance
+  bool ambiguous = false;        ///< another consistent entry within ambiguity_distance, or
+                                 ///< a candidate below the chosen link that could not be tested
   bool decided = false;          ///< false: no candidate could be tested (paper's rule kept)
 };
 
