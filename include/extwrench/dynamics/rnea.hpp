@@ -47,7 +47,11 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
 const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                             const Eigen::Ref<const VectorX>& dq);
 
-/// Gravity torques g(q) into data.gravity_torque.
+/// Gravity torques g(q) into data.gravity_torque: an O(n) pass over the subtrees' masses and
+/// first moments in body frames (docs/algorithms.md), without velocities, inertia tensors or
+/// world poses. Writes only data.gravity_torque and the scratch gravity_B, gravity_lin_B,
+/// gravity_moment_B, composite_mass, composite_first_moment_B, sin_q, cos_q (not data.tau, X_WB
+/// or S). Armature does not enter g. q: (n).
 const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q);
 
 /// Coriolis matrix C(q, dq) into data.C, the factorization with B_dot = C + C^T
