@@ -173,9 +173,10 @@ Vector6 sensor_reading(const Data& data, const Pose& X_WS) {
 
 const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                             const Eigen::Ref<const VectorX>& dq) {
-  forward_kinematics(model, data, q);
+  // rnea at q_ddot = 0: its fused pass needs no world inertia R I_c R^T (forward_kinematics
+  // followed by rnea_no_kinematics formed them all).
   data.tmp_n.setZero();
-  return rnea_no_kinematics(model, data, dq, data.tmp_n, {}, true);
+  return rnea(model, data, q, dq, data.tmp_n);
 }
 
 const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {

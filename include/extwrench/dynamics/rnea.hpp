@@ -43,7 +43,8 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
 /// The same reading expressed in the world frame (moment still about O_s).
 [[nodiscard]] Vector6 sensor_reading_world(const Data& data, const Vector3& p_WS);
 
-/// Bias torques c(q, dq) = C(q, dq) dq + g(q) into data.tau.
+/// Bias torques c(q, dq) = C(q, dq) dq + g(q) into data.tau: rnea at ddq = 0 (it leaves what
+/// rnea leaves, not the world mass properties of forward_kinematics). q, dq: (n).
 const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                             const Eigen::Ref<const VectorX>& dq);
 
