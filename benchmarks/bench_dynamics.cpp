@@ -130,6 +130,23 @@ void BM_Jacobian_Ours(benchmark::State& state) {
 }
 BENCHMARK(BM_Jacobian_Ours);
 
+// The same Jacobian after forward_poses: the poses without the world mass properties.
+void BM_JacobianPoses_Ours(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const StatePool& s = state_pool();
+  Data data(arm.model);
+  const int tip = arm.model.nq();
+  auto call = [&](std::size_t k) {
+    forward_poses(arm.model, data, s.q[k & kMask]);
+    benchmark::DoNotOptimize(body_jacobian(arm.model, data, tip).data());
+  };
+  std::size_t k = 0;
+  for (auto _ : state) call(k++);
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+}
+BENCHMARK(BM_JacobianPoses_Ours);
+
 void BM_Jacobian_Kdl(benchmark::State& state) {
   const PaperArm& arm = paper_arm();
   const StatePool& s = state_pool();

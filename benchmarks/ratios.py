@@ -17,6 +17,8 @@ PAIRS = [
     ("RNEA (torques only) vs KDL RNE", "BM_Rnea_Kdl", "BM_Rnea_Ours", None),
     ("mass matrix vs ChainDynParam::JntToMass", "BM_MassMatrix_Kdl", "BM_MassMatrix_Ours", None),
     ("flange Jacobian vs ChainJntToJacSolver", "BM_Jacobian_Kdl", "BM_Jacobian_Ours", None),
+    ("flange Jacobian after forward_poses vs ChainJntToJacSolver",
+     "BM_Jacobian_Kdl", "BM_JacobianPoses_Ours", 5.0),
     ("gravity g(q) vs ChainDynParam::JntToGravity", "BM_Gravity_Kdl", "BM_Gravity_Ours", 6.0),
     ("bias C q̇ + g vs ChainDynParam::JntToCoriolis (C q̇ only)",
      "BM_Coriolis_Kdl", "BM_Bias_Ours", None),

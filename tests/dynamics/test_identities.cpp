@@ -199,6 +199,22 @@ TEST(GravityPass, PaperArmEqualsRneaAtRestAndTheBiasPass) {
   }
 }
 
+TEST_P(DynamicsIdentities, ForwardPosesAreTheForwardKinematicsPosesBitForBit) {
+  Data data(model_);
+  Data full(model_);
+  SeededRng rng(26);
+  for (int k = 0; k < 20; ++k) {
+    const VectorX q = rng.uniform_vector(model_.nq(), -3, 3);
+    forward_poses(model_, data, q);
+    forward_kinematics(model_, full, q);
+    for (int i = 0; i < model_.num_bodies(); ++i) {
+      EXPECT_EQ(data.X_WB[i].rotation, full.X_WB[i].rotation) << k << " body " << i;
+      EXPECT_EQ(data.X_WB[i].translation, full.X_WB[i].translation) << k << " body " << i;
+      EXPECT_EQ(data.S[i], full.S[i]) << k << " body " << i;
+    }
+  }
+}
+
 TEST_P(DynamicsIdentities, MassMatrixEqualsRneaColumns) {
   Data data(model_);
   SeededRng rng(15);
