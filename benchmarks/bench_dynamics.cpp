@@ -130,6 +130,23 @@ void BM_Jacobian_Ours(benchmark::State& state) {
 }
 BENCHMARK(BM_Jacobian_Ours);
 
+// The same Jacobian after forward_poses: the poses without the world mass properties.
+void BM_JacobianPoses_Ours(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const StatePool& s = state_pool();
+  Data data(arm.model);
+  const int tip = arm.model.nq();
+  auto call = [&](std::size_t k) {
+    forward_poses(arm.model, data, s.q[k & kMask]);
+    benchmark::DoNotOptimize(body_jacobian(arm.model, data, tip).data());
+  };
+  std::size_t k = 0;
+  for (auto _ : state) call(k++);
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+}
+BENCHMARK(BM_JacobianPoses_Ours);
+
 void BM_Jacobian_Kdl(benchmark::State& state) {
   const PaperArm& arm = paper_arm();
   const StatePool& s = state_pool();
@@ -145,6 +162,90 @@ void BM_Jacobian_Kdl(benchmark::State& state) {
       allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
 BENCHMARK(BM_Jacobian_Kdl);
+
+// ---- gravity g(q) and the Coriolis torques -------------------------------------------------
+
+// The gravity pass of issue 15: subtree masses and first moments in body frames, no velocity.
+void BM_Gravity_Ours(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const StatePool& s = state_pool();
+  Data data(arm.model);
+  auto call = [&](std::size_t k) {
+    benchmark::DoNotOptimize(gravity_torques(arm.model, data, s.q[k & kMask]).data());
+  };
+  std::size_t k = 0;
+  for (auto _ : state) call(k++);
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+}
+BENCHMARK(BM_Gravity_Ours);
+
+// What gravity_torques ran before issue 15 (the reference the pass must beat by 2x): forward
+// kinematics with the world mass properties, then the whole bias pass at q_dot = q_ddot = 0.
+void BM_GravityBiasPass_Ours(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const StatePool& s = state_pool();
+  Data data(arm.model);
+  const VectorX zero = VectorX::Zero(arm.model.nq());
+  auto call = [&](std::size_t k) {
+    forward_kinematics(arm.model, data, s.q[k & kMask]);
+    benchmark::DoNotOptimize(rnea_no_kinematics(arm.model, data, zero, zero, {}, true).data());
+  };
+  std::size_t k = 0;
+  for (auto _ : state) call(k++);
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+}
+BENCHMARK(BM_GravityBiasPass_Ours);
+
+void BM_Gravity_Kdl(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const StatePool& s = state_pool();
+  KDL::ChainDynParam solver(arm.chain, kdl_gravity(arm.model));
+  KDL::JntArray gravity(arm.chain.getNrOfJoints());
+  auto call = [&](std::size_t k) {
+    benchmark::DoNotOptimize(solver.JntToGravity(s.kq[k & kMask], gravity));
+    benchmark::DoNotOptimize(gravity.data.data());
+  };
+  std::size_t k = 0;
+  for (auto _ : state) call(k++);
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+}
+BENCHMARK(BM_Gravity_Kdl);
+
+// Our closest exposed function to KDL's C(q, q_dot) q_dot: bias_torques, C q_dot + g (g too).
+void BM_Bias_Ours(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const StatePool& s = state_pool();
+  Data data(arm.model);
+  auto call = [&](std::size_t k) {
+    k &= kMask;
+    benchmark::DoNotOptimize(bias_torques(arm.model, data, s.q[k], s.dq[k]).data());
+  };
+  std::size_t k = 0;
+  for (auto _ : state) call(k++);
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+}
+BENCHMARK(BM_Bias_Ours);
+
+void BM_Coriolis_Kdl(benchmark::State& state) {
+  const PaperArm& arm = paper_arm();
+  const StatePool& s = state_pool();
+  KDL::ChainDynParam solver(arm.chain, kdl_gravity(arm.model));
+  KDL::JntArray coriolis(arm.chain.getNrOfJoints());
+  auto call = [&](std::size_t k) {
+    k &= kMask;
+    benchmark::DoNotOptimize(solver.JntToCoriolis(s.kq[k], s.kdq[k], coriolis));
+    benchmark::DoNotOptimize(coriolis.data.data());
+  };
+  std::size_t k = 0;
+  for (auto _ : state) call(k++);
+  state.counters["allocs"] =
+      allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
+}
+BENCHMARK(BM_Coriolis_Kdl);
 
 // ---- the model terms of the residual (4): B q̇, Cᵀq̇, g ------------------------------------
 

@@ -17,6 +17,11 @@ PAIRS = [
     ("RNEA (torques only) vs KDL RNE", "BM_Rnea_Kdl", "BM_Rnea_Ours", None),
     ("mass matrix vs ChainDynParam::JntToMass", "BM_MassMatrix_Kdl", "BM_MassMatrix_Ours", None),
     ("flange Jacobian vs ChainJntToJacSolver", "BM_Jacobian_Kdl", "BM_Jacobian_Ours", None),
+    ("flange Jacobian after forward_poses vs ChainJntToJacSolver",
+     "BM_Jacobian_Kdl", "BM_JacobianPoses_Ours", 5.0),
+    ("gravity g(q) vs ChainDynParam::JntToGravity", "BM_Gravity_Kdl", "BM_Gravity_Ours", 6.0),
+    ("bias C q̇ + g vs ChainDynParam::JntToCoriolis (C q̇ only)",
+     "BM_Coriolis_Kdl", "BM_Bias_Ours", None),
     ("residual model terms (Bq̇, Cᵀq̇, g) vs JntToMass+Coriolis+Gravity",
      "BM_MomentumTerms_Kdl", "BM_MomentumTerms_Ours", None),
     ("residual + EE wrench (case E, l = n) vs JntToExtWrench",
@@ -24,6 +29,12 @@ PAIRS = [
     ("residual alone vs JntToExtWrench", "BM_ExtWrench_Kdl", "BM_Residual_Ours", None),
     ("full update, F/T, unknown point, capsules vs JntToExtWrench",
      "BM_ExtWrench_Kdl", "BM_FullUpdate_Ours/ft/pure_force/capsules", 5.0),
+]
+# (label, our earlier path, our current one, target for earlier/current or None): speed-ups of
+# our own code, measured in the same run.
+SELF_PAIRS = [
+    ("gravity: the whole bias pass (before issue 15) / the gravity pass",
+     "BM_GravityBiasPass_Ours", "BM_Gravity_Ours", 2.0),
 ]
 FULL_PREFIX = "BM_FullUpdate_Ours/"
 LATENCY_PREFIX = "BM_Latency_"
@@ -74,6 +85,18 @@ def ratio_rows(runs):
     return rows
 
 
+def self_rows(runs):
+    rows = []
+    for label, before, after, target in SELF_PAIRS:
+        if before in runs and after in runs:
+            r = runs[before]["ns"] / runs[after]["ns"]
+            verdict = "" if target is None else ("met" if r >= target else "NOT MET")
+            rows.append((label, runs[before], runs[after], r, target, verdict))
+        else:
+            rows.append((label, runs.get(before), runs.get(after), None, target, "missing"))
+    return rows
+
+
 def print_console(context, runs, use_real):
     print(f"\nextwrench vs KDL ({'wall' if use_real else 'CPU'} time, medians); "
           f"robot: {context.get('robot', '?')}")
@@ -83,6 +106,13 @@ def print_console(context, runs, use_real):
             continue
         t = f" (target ≥ {target:g}×: {verdict})" if target else ""
         print(f"  {label:<68} {fmt_ns(kdl['ns']):>10} / {fmt_ns(ours['ns']):>10} = "
+              f"{r:5.1f}×{t}")
+    for label, before, after, r, target, verdict in self_rows(runs):
+        if r is None:
+            print(f"  {label:<68} missing")
+            continue
+        t = f" (target ≥ {target:g}×: {verdict})" if target else ""
+        print(f"  {label:<68} {fmt_ns(before['ns']):>10} / {fmt_ns(after['ns']):>10} = "
               f"{r:5.1f}×{t}")
     for name, e in runs.items():
         if name.startswith(LATENCY_PREFIX):
@@ -111,6 +141,14 @@ def print_markdown(context, runs, use_real):
             continue
         t = f"≥ {target:g}× ({verdict})" if target else ""
         print(f"| {label} | {fmt_ns(kdl['ns'])} | {fmt_ns(ours['ns'])} | **{r:.1f}×** | {t} |")
+    print("\n| our own speed-up | before | now | before / now | target |")
+    print("|---|---:|---:|---:|---|")
+    for label, before, after, r, target, verdict in self_rows(runs):
+        if r is None:
+            print(f"| {label} | – | – | – | missing |")
+            continue
+        t = f"≥ {target:g}× ({verdict})" if target else ""
+        print(f"| {label} | {fmt_ns(before['ns'])} | {fmt_ns(after['ns'])} | **{r:.1f}×** | {t} |")
     lat = [(n, e) for n, e in runs.items() if n.startswith(LATENCY_PREFIX)]
     if lat:
         print("\n| latency per call (steady clock) | calls | min | median | p99 | p99.9 | max |")

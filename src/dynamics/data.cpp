@@ -13,6 +13,8 @@ struct JointRotation {
   Matrix3 rotation_cos = Matrix3::Zero();
   Matrix3 rotation_sin = Matrix3::Zero();
   Vector3 axis_P = Vector3::Zero();
+  Vector6 S_B = Vector6::Zero();
+  Vector3 slide_P = Vector3::Zero();
 };
 
 JointRotation joint_rotation(const Joint& joint) {
@@ -25,8 +27,11 @@ JointRotation joint_rotation(const Joint& joint) {
     out.rotation_const = P * aaT;
     out.rotation_cos = P * (Matrix3::Identity() - aaT);
     out.rotation_sin = P * skew(a);
+    out.S_B.tail<3>() = a;
   } else {
     out.rotation_const = P;
+    out.S_B.head<3>() = a;
+    out.slide_P = out.axis_P;
   }
   return out;
 }
@@ -45,12 +50,22 @@ Data::Data(const Model& model) {
   rotation_cos.assign(nb, Matrix3::Zero());
   rotation_sin.assign(nb, Matrix3::Zero());
   axis_P.assign(nb, Vector3::Zero());
+  rotation_const_T.assign(nb, Matrix3::Identity());
+  rotation_cos_T.assign(nb, Matrix3::Zero());
+  rotation_sin_T.assign(nb, Matrix3::Zero());
+  S_B.assign(nb, Vector6::Zero());
+  slide_P.assign(nb, Vector3::Zero());
   for (std::size_t i = 1; i < nb && i < model.joints.size(); ++i) {
     const JointRotation r = joint_rotation(model.joints[i]);
     rotation_const[i] = r.rotation_const;
     rotation_cos[i] = r.rotation_cos;
     rotation_sin[i] = r.rotation_sin;
     axis_P[i] = r.axis_P;
+    rotation_const_T[i] = r.rotation_const.transpose();
+    rotation_cos_T[i] = r.rotation_cos.transpose();
+    rotation_sin_T[i] = r.rotation_sin.transpose();
+    S_B[i] = r.S_B;
+    slide_P[i] = r.slide_P;
   }
   X_WB.assign(nb, Pose{});
   S.assign(nb, Vector6::Zero());
@@ -65,6 +80,10 @@ Data::Data(const Model& model) {
   composite_mass.assign(nb, 0.0);
   composite_first_moment.assign(nb, Vector3::Zero());
   composite_inertia_O.assign(nb, Matrix3::Zero());
+  composite_first_moment_B.assign(nb, Vector3::Zero());
+  gravity_B.assign(nb, Vector3::Zero());
+  gravity_lin_B.assign(nb, 0.0);
+  gravity_moment_B.assign(nb, Vector3::Zero());
   Ic.assign(nb, Matrix6::Zero());
   Bc.assign(nb, Matrix6::Zero());
   Sdot.assign(nb, Vector6::Zero());
@@ -89,11 +108,14 @@ bool Data::matches(const Model& model) const {
   const Eigen::Index n = model.nq();
   const bool bodies_sized =
       sized(rotation_const, nb) && sized(rotation_cos, nb) && sized(rotation_sin, nb) &&
-      sized(axis_P, nb) && sized(X_WB, nb) && sized(S, nb) && sized(mass, nb) &&
-      sized(first_moment_W, nb) && sized(inertia_O_W, nb) && sized(v, nb) && sized(a, nb) &&
-      sized(f, nb) && sized(h, nb) && sized(bias_f, nb) && sized(composite_mass, nb) &&
-      sized(composite_first_moment, nb) && sized(composite_inertia_O, nb) && sized(Ic, nb) &&
-      sized(Bc, nb) && sized(Sdot, nb);
+      sized(axis_P, nb) && sized(rotation_const_T, nb) && sized(rotation_cos_T, nb) &&
+      sized(rotation_sin_T, nb) && sized(S_B, nb) && sized(slide_P, nb) && sized(X_WB, nb) &&
+      sized(S, nb) && sized(mass, nb) && sized(first_moment_W, nb) && sized(inertia_O_W, nb) &&
+      sized(v, nb) && sized(a, nb) && sized(f, nb) && sized(h, nb) && sized(bias_f, nb) &&
+      sized(composite_mass, nb) && sized(composite_first_moment, nb) &&
+      sized(composite_inertia_O, nb) && sized(composite_first_moment_B, nb) &&
+      sized(gravity_B, nb) && sized(gravity_lin_B, nb) && sized(gravity_moment_B, nb) &&
+      sized(Ic, nb) && sized(Bc, nb) && sized(Sdot, nb);
   const bool joints_sized = tau.size() == n && M.rows() == n && M.cols() == n && C.rows() == n &&
                             C.cols() == n && momentum.size() == n &&
                             coriolis_transpose_dq.size() == n && gravity_torque.size() == n &&
@@ -103,7 +125,10 @@ bool Data::matches(const Model& model) const {
   for (std::size_t i = 1; i < nb && i < model.joints.size(); ++i) {
     const JointRotation r = joint_rotation(model.joints[i]);
     if (r.rotation_const != rotation_const[i] || r.rotation_cos != rotation_cos[i] ||
-        r.rotation_sin != rotation_sin[i] || r.axis_P != axis_P[i]) {
+        r.rotation_sin != rotation_sin[i] || r.axis_P != axis_P[i] || r.S_B != S_B[i] ||
+        r.slide_P != slide_P[i] || r.rotation_const.transpose() != rotation_const_T[i] ||
+        r.rotation_cos.transpose() != rotation_cos_T[i] ||
+        r.rotation_sin.transpose() != rotation_sin_T[i]) {
       return false;
     }
   }

@@ -12,6 +12,10 @@ void forward_kinematics(const Model& model, Data& data, const Eigen::Ref<const V
   world_mass_properties(model, data);
 }
 
+void forward_poses(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  detail::poses_and_subspaces(model, data, q);
+}
+
 void world_mass_properties(const Model& model, Data& data) {
   const int nb = model.num_bodies();
   for (int i = 0; i < nb; ++i) detail::world_mass_properties_of(model, data, i);

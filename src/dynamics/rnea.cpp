@@ -173,16 +173,81 @@ Vector6 sensor_reading(const Data& data, const Pose& X_WS) {
 
 const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                             const Eigen::Ref<const VectorX>& dq) {
-  forward_kinematics(model, data, q);
+  // rnea at q_ddot = 0: its fused pass needs no world inertia R I_c R^T (forward_kinematics
+  // followed by rnea_no_kinematics formed them all).
   data.tmp_n.setZero();
-  return rnea_no_kinematics(model, data, dq, data.tmp_n, {}, true);
+  return rnea(model, data, q, dq, data.tmp_n);
 }
 
 const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
-  forward_kinematics(model, data, q);
-  data.tmp_n.setZero();
-  rnea_no_kinematics(model, data, data.tmp_n, data.tmp_n, {}, true);
-  data.gravity_torque = data.tau;
+  // g_i = -S_i^T [m^c_i g; h^c_i x g] (the subtree's weight as a wrench), evaluated in body i's
+  // own frame, where S_i is the constant data.S_B[i]: no world pose, no inertia tensor, no
+  // velocity. Forward: the gravity vector in each body's axes, g_i = E_i(q)^T g_p. Backward: the
+  // subtree's mass and first moment about body i's origin, h^c_p += m^c_i t_i + E_i h^c_i with
+  // t_i = placement_i + slide_i q_i. Both products go through detail::rotation_times (E^T from
+  // Data's transposed constants), so no 3x3 is formed. Along a chain the carried vectors stay in
+  // registers.
+  const int nb = model.num_bodies();
+  // Not detail::joint_sin_cos: glibc's sincos was a third of this pass (sin_cos_poly).
+  for (int j = 0; j < nb - 1; ++j) detail::sin_cos_poly(q[j], data.sin_q[j], data.cos_q[j]);
+  Vector3 g = model.gravity;  // body 0 is the world frame
+  data.gravity_B[0] = g;
+  {
+    const Inertia& inertia = model.bodies[0].inertia;
+    data.composite_mass[0] = inertia.mass;
+    data.composite_first_moment_B[0] = inertia.mass * inertia.com;
+  }
+  for (int i = 1; i < nb; ++i) {
+    if (model.parents[i] != i - 1) g = data.gravity_B[model.parents[i]];
+    const double c = data.cos_q[i - 1];
+    const double s = data.sin_q[i - 1];
+    const Vector3 g_i = detail::rotation_times(data.rotation_const_T[i], data.rotation_cos_T[i],
+                                               data.rotation_sin_T[i], c, s, g);
+    g = g_i;
+    data.gravity_B[i] = g_i;
+    // The torque's gravity factors, off the backward pass's critical path:
+    // torque_i = -(m^c_i s_lin . g_i + h^c_i . (g_i x s_ang)).
+    const Vector6& S = data.S_B[i];
+    data.gravity_lin_B[i] = S.head<3>().dot(g_i);
+    data.gravity_moment_B[i] = g_i.cross(S.tail<3>());
+    const Inertia& inertia = model.bodies[i].inertia;
+    data.composite_mass[i] = inertia.mass;
+    data.composite_first_moment_B[i] = inertia.mass * inertia.com;
+  }
+  double m_child = 0.0;  // the chain child's subtree, in this body's axes about its origin
+  Vector3 h_child = Vector3::Zero();
+  for (int i = nb - 1; i > 0; --i) {
+    const int p = model.parents[i];
+    const bool chain_child = i + 1 < nb && model.parents[i + 1] == i;
+    double m = data.composite_mass[i];
+    Vector3 h = data.composite_first_moment_B[i];
+    if (chain_child) {
+      m += m_child;
+      h += h_child;
+    }
+    data.composite_mass[i] = m;
+    data.composite_first_moment_B[i] = h;
+    data.gravity_torque[i - 1] = -(m * data.gravity_lin_B[i] + h.dot(data.gravity_moment_B[i]));
+    // Into the parent's frame: X_pi = (E_i, t_i).
+    const double c = data.cos_q[i - 1];
+    const double s = data.sin_q[i - 1];
+    const Vector3 t = model.joints[i].placement.translation + data.slide_P[i] * q[i - 1];
+    const Vector3 h_p = m * t + detail::rotation_times(data.rotation_const[i], data.rotation_cos[i],
+                                                       data.rotation_sin[i], c, s, h);
+    if (p == i - 1) {
+      m_child = m;
+      h_child = h_p;
+    } else {
+      data.composite_mass[p] += m;
+      data.composite_first_moment_B[p] += h_p;
+      m_child = 0.0;
+      h_child.setZero();
+    }
+  }
+  if (nb > 1 && model.parents[1] == 0) {
+    data.composite_mass[0] += m_child;
+    data.composite_first_moment_B[0] += h_child;
+  }
   return data.gravity_torque;
 }
 

@@ -71,6 +71,7 @@ class DynamicsAllocations : public ::testing::TestWithParam<Case> {
 TEST_P(DynamicsAllocations, ForwardKinematicsAndFramePosesAllocateNothing) {
   Data data(model_);
   EXPECT_EQ(allocations_in([&] { forward_kinematics(model_, data, q_); }), 0u);
+  EXPECT_EQ(allocations_in([&] { forward_poses(model_, data, q_); }), 0u);
   const int frame = model_.num_bodies() - 1;
   Pose X;
   EXPECT_EQ(allocations_in([&] { X = frame_pose(model_, data, frame); }), 0u);

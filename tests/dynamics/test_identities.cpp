@@ -3,6 +3,9 @@
 // every algorithm checked against another path (finite differences, RNEA columns, Newton's law).
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/momentum.hpp"
@@ -118,6 +121,97 @@ TEST_P(DynamicsIdentities, MomentumPassMatchesTheSixVectorOracle) {
               kAlgebraicTol * scale(oracle.coriolis_transpose_dq));
     EXPECT_LE((data.gravity_torque - oracle.gravity_torque).cwiseAbs().maxCoeff(),
               kAlgebraicTol * scale(oracle.gravity_torque));
+  }
+}
+
+// The gravity pass (body frames, subtree first moments) against the two earlier paths to g(q):
+// rnea at rest, and forward kinematics + the whole bias pass at q_dot = q_ddot = 0 (what
+// gravity_torques ran before issue 15). Reordered floating point only: 1e-12 relative.
+constexpr double kGravityTol = 1e-12;
+
+double gravity_error_against_bias_pass(const Model& model, Data& data, Data& other,
+                                       const VectorX& q) {
+  const VectorX g = gravity_torques(model, data, q);
+  const VectorX zero = VectorX::Zero(model.nq());
+  const VectorX at_rest = rnea(model, other, q, zero, zero);
+  forward_kinematics(model, other, q);
+  const VectorX bias_pass = rnea_no_kinematics(model, other, zero, zero, {}, true);
+  return std::max(test::relative_error(g, at_rest), test::relative_error(g, bias_pass));
+}
+
+TEST_P(DynamicsIdentities, GravityPassEqualsRneaAtRestAndTheBiasPass) {
+  Data data(model_);
+  Data other(model_);
+  SeededRng rng(22);
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(model_.nq(), -3, 3);
+    EXPECT_LE(gravity_error_against_bias_pass(model_, data, other, q), kGravityTol) << k;
+  }
+}
+
+// The pass's own sin/cos (no libm call below 2^20 rad) in every quadrant, at its seams
+// (multiples of pi/4), far out, and past 2^20 rad where it falls back to libm.
+TEST_P(DynamicsIdentities, GravityPassHoldsAtLargeAnglesAndQuadrantSeams) {
+  Data data(model_);
+  Data other(model_);
+  SeededRng rng(25);
+  const int n = model_.nq();
+  for (int k = 0; k < kStates; ++k) {
+    VectorX q = rng.uniform_vector(n, -1e4, 1e4);
+    if (k % 4 == 1) {
+      for (int i = 0; i < n; ++i) q[i] = (k / 4 % 17 - 8 + i) * (std::numbers::pi / 4);
+    } else if (k % 4 == 2) {
+      q = rng.uniform_vector(n, -3e6, 3e6);
+    }
+    // Angles only: a prismatic joint stays within a metre (kilometres of lever arm would test
+    // cancellation in the torques, not the sines).
+    for (int i = 0; i < n; ++i) {
+      if (model_.joints[i + 1].type == JointType::kPrismatic) q[i] = std::remainder(q[i], 1.0);
+    }
+    EXPECT_LE(gravity_error_against_bias_pass(model_, data, other, q), kGravityTol) << k;
+  }
+}
+
+TEST_P(DynamicsIdentities, GravityPassIgnoresArmatureAndWhatDataHeld) {
+  Model with_armature = model_;
+  SeededRng rng(23);
+  for (Joint& j : with_armature.joints) j.armature = rng.uniform(0.01, 0.5);
+  Data data(model_);
+  Data used(with_armature);
+  for (int k = 0; k < 20; ++k) {
+    const VectorX q = rng.uniform_vector(model_.nq(), -3, 3);
+    const VectorX g = gravity_torques(model_, data, q);
+    // `used` last held another state's poses, momenta and bias terms.
+    const VectorX q_other = rng.uniform_vector(model_.nq(), -3, 3);
+    momentum_and_bias_terms(with_armature, used, q_other, rng.uniform_vector(model_.nq(), -2, 2));
+    EXPECT_EQ(gravity_torques(with_armature, used, q), g) << k;
+  }
+}
+
+TEST(GravityPass, PaperArmEqualsRneaAtRestAndTheBiasPass) {
+  const Model model = paper_arm();
+  Data data(model);
+  Data other(model);
+  SeededRng rng(24);
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = rng.uniform_vector(model.nq(), -3.1, 3.1);
+    EXPECT_LE(gravity_error_against_bias_pass(model, data, other, q), kGravityTol) << k;
+  }
+}
+
+TEST_P(DynamicsIdentities, ForwardPosesAreTheForwardKinematicsPosesBitForBit) {
+  Data data(model_);
+  Data full(model_);
+  SeededRng rng(26);
+  for (int k = 0; k < 20; ++k) {
+    const VectorX q = rng.uniform_vector(model_.nq(), -3, 3);
+    forward_poses(model_, data, q);
+    forward_kinematics(model_, full, q);
+    for (int i = 0; i < model_.num_bodies(); ++i) {
+      EXPECT_EQ(data.X_WB[i].rotation, full.X_WB[i].rotation) << k << " body " << i;
+      EXPECT_EQ(data.X_WB[i].translation, full.X_WB[i].translation) << k << " body " << i;
+      EXPECT_EQ(data.S[i], full.S[i]) << k << " body " << i;
+    }
   }
 }
 

@@ -44,6 +44,7 @@
 #include "extwrench/io/robot_loader.hpp"
 #include "reference/reference_util.hpp"
 #include "support/random.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {
@@ -53,6 +54,8 @@ using test::SeededRng;
 // Two independent double-precision implementations of the same recursions: they differ by
 // round-off only (~1e-14 relative here); 1e-9 leaves room without hiding any modelling error.
 constexpr double kTol = 1e-9;
+// g(q) needs no velocity terms: ours and KDL's differ by a few ulps of the torques.
+constexpr double kGravityTol = 1e-12;
 constexpr int kStates = 200;
 const char* const kWorld = "kdl_world";
 
@@ -416,7 +419,47 @@ TEST_P(KdlReference, GravityTorquesMatchKdl) {
     const double e = std::max(rel_err(ref_.P * g, g_ref.data),
                               rel_err(ref_.P * data.gravity_torque, g_ref.data));
     worst.update(e);
-    EXPECT_LE(e, kTol) << "state " << k;
+    EXPECT_LE(e, kGravityTol) << "state " << k;
+  }
+}
+
+// g(q) of random chains and trees (revolute and prismatic joints) against KDL's tree RNE at
+// rest, on the URDF model_to_urdf writes (kdl_parser reads it; KDL's q_nr mapped by joint name).
+TEST(KdlGravity, RandomChainsAndTreesMatchKdlTreeRneaAtRest) {
+  const RandomChainOptions cases[] = {{.n = 7, .seed = 31},
+                                      {.n = 6, .prismatic = true, .seed = 32},
+                                      {.n = 9, .tree = true, .seed = 33},
+                                      {.n = 12, .tree = true, .prismatic = true, .seed = 34}};
+  for (const RandomChainOptions& o : cases) {
+    const Model model = random_chain(o);
+    const int n = model.nq();
+    KDL::Tree tree;
+    ASSERT_TRUE(kdl_parser::treeFromString(test::model_to_urdf(model), tree));
+    ASSERT_EQ(tree.getNrOfJoints(), static_cast<unsigned>(n));
+    KDL::TreeIdSolver_RNE solver(tree, to_kdl(model.gravity));
+    std::vector<int> ours_of_kdl(static_cast<std::size_t>(n));
+    for (const auto& [name, element] : tree.getSegments()) {
+      const KDL::Joint& j = element.segment.getJoint();
+      if (j.getType() == KDL::Joint::None) continue;
+      ours_of_kdl[element.q_nr] = *model.find_joint(j.getName()) - 1;
+    }
+    Data data(model);
+    SeededRng rng(108);
+    Worst worst{"random model " + std::to_string(o.seed) + " g(q) vs KDL tree RNE"};
+    const auto nk = static_cast<unsigned>(n);
+    const KDL::JntArray zero(nk);
+    for (int k = 0; k < kStates; ++k) {
+      const VectorX q = rng.uniform_vector(n, -3.1, 3.1);
+      KDL::JntArray qk(nk), tk(nk);
+      for (unsigned i = 0; i < nk; ++i) qk(i) = q[ours_of_kdl[i]];
+      ASSERT_GE(solver.CartToJnt(qk, zero, zero, KDL::WrenchMap{}, tk), 0);
+      const VectorX& g = gravity_torques(model, data, q);
+      VectorX g_ref(n);
+      for (unsigned i = 0; i < nk; ++i) g_ref[ours_of_kdl[i]] = tk(i);
+      const double e = rel_err(g, g_ref);
+      worst.update(e);
+      EXPECT_LE(e, kGravityTol) << "seed " << o.seed << " state " << k;
+    }
   }
 }
 

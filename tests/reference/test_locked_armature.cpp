@@ -36,6 +36,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr double kTol = 1e-9;
+// g(q) has no velocity terms: ours and KDL's differ by a few ulps (relative_error, floor 1 N m).
+constexpr double kGravityTol = 1e-12;
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
@@ -83,6 +85,7 @@ TEST(LockedPanda, InverseDynamicsMatchesKdlOnTheUrdfWithFixedFingers) {
   Data data(model);
   test::SeededRng rng(11);
   double worst = 0.0;
+  double worst_gravity = 0.0;
   for (int trial = 0; trial < 50; ++trial) {
     const VectorX q = rng.uniform_vector(7, -1.5, 1.5);
     const VectorX dq = rng.uniform_vector(7, -2.0, 2.0);
@@ -96,9 +99,20 @@ TEST(LockedPanda, InverseDynamicsMatchesKdlOnTheUrdfWithFixedFingers) {
     ASSERT_GE(solver.CartToJnt(qk, dqk, ddqk, KDL::WrenchMap{}, tk), 0);
     const VectorX& tau = rnea(model, data, q, dq, ddq);
     for (int k = 0; k < 7; ++k) worst = std::max(worst, std::abs(tau[ours_of_kdl[k]] - tk(k)));
+    // g(q): the gravity pass on the locked model against KDL's RNE at rest.
+    const KDL::JntArray zero(7);
+    ASSERT_GE(solver.CartToJnt(qk, zero, zero, KDL::WrenchMap{}, tk), 0);
+    VectorX g_ref(7);
+    for (int k = 0; k < 7; ++k) g_ref[ours_of_kdl[k]] = tk(k);
+    worst_gravity =
+        std::max(worst_gravity, test::relative_error(gravity_torques(model, data, q), g_ref));
   }
-  std::printf("locked Panda vs KDL TreeIdSolver_RNE: max |tau| difference %.3g N m\n", worst);
+  std::printf(
+      "locked Panda vs KDL TreeIdSolver_RNE: max |tau| difference %.3g N m, "
+      "g(q) relative difference %.3g\n",
+      worst, worst_gravity);
   EXPECT_LT(worst, kTol);
+  EXPECT_LT(worst_gravity, kGravityTol);
 }
 
 // ---- armature against KDL's joint inertia ---------------------------------------------------
@@ -149,6 +163,7 @@ TEST(Armature, RneaAndMassMatrixMatchKdlJointInertia) {
   test::SeededRng rng(12);
   double worst_tau = 0.0;
   double worst_mass = 0.0;
+  double worst_gravity = 0.0;
   for (int trial = 0; trial < 50; ++trial) {
     const VectorX q = rng.uniform_vector(7, -2.0, 2.0);
     const VectorX dq = rng.uniform_vector(7, -2.0, 2.0);
@@ -164,11 +179,17 @@ TEST(Armature, RneaAndMassMatrixMatchKdlJointInertia) {
     KDL::JntSpaceInertiaMatrix H(7);
     ASSERT_GE(dyn.JntToMass(qk, H), 0);
     worst_mass = std::max(worst_mass, (crba(model, data, q) - H.data).cwiseAbs().maxCoeff());
+    // Armature does not enter g(q).
+    KDL::JntArray gk(7);
+    ASSERT_GE(dyn.JntToGravity(qk, gk), 0);
+    worst_gravity =
+        std::max(worst_gravity, test::relative_error(gravity_torques(model, data, q), gk.data));
   }
-  std::printf("armature vs KDL joint inertia: max |tau| %.3g, max |B| %.3g\n", worst_tau,
-              worst_mass);
+  std::printf("armature vs KDL joint inertia: max |tau| %.3g, max |B| %.3g, g(q) relative %.3g\n",
+              worst_tau, worst_mass, worst_gravity);
   EXPECT_LT(worst_tau, kTol);
   EXPECT_LT(worst_mass, kTol);
+  EXPECT_LT(worst_gravity, kGravityTol);
 }
 
 // ---- armature against MuJoCo ------------------------------------------------------------------

@@ -15,9 +15,10 @@ namespace extwrench {
 struct Data {
   explicit Data(const Model& model);
 
-  /// True if this Data was sized for `model` and its cached joint rotations (rotation_const,
-  /// rotation_cos, rotation_sin, axis_P) are those of model's joints: a Data built for one
-  /// Model is not valid for another of the same size whose joint axes or placements differ.
+  /// True if this Data was sized for `model` and its cached joint terms (rotation_const,
+  /// rotation_cos, rotation_sin and their transposes, axis_P, S_B, slide_P) are those of model's
+  /// joints: a Data built for one Model is not valid for another of the same size whose joint axes
+  /// or placements differ.
   [[nodiscard]] bool matches(const Model& model) const;
 
   // --- derived from the model once, for the hot path ---
@@ -28,6 +29,15 @@ struct Data {
   /// type or axis and nothing indexed at run time.
   std::vector<Matrix3> rotation_const, rotation_cos, rotation_sin;
   std::vector<Vector3> axis_P;  ///< P_i a: joint i's axis in the parent body frame
+  /// The transposes of rotation_const, rotation_cos, rotation_sin: E_i(q)^T from them is a
+  /// combination of columns (gravity_torques' forward pass, g_i = E_i^T g_p).
+  std::vector<Matrix3> rotation_const_T, rotation_cos_T, rotation_sin_T;
+  /// Joint i's motion subspace in body i's own frame, about its origin (a point of the axis):
+  /// revolute [0; a], prismatic [a; 0]. Constant: gravity_torques works in body frames with it.
+  std::vector<Vector6> S_B;
+  /// The parent-frame translation of joint i per unit of q: P_i a for a prismatic joint, zero for
+  /// a revolute one, so body i's origin in its parent is placement + slide_P q for every joint.
+  std::vector<Vector3> slide_P;
 
   // --- forward kinematics (forward_kinematics) ---
   std::vector<Pose> X_WB;  ///< pose of each body frame in the world
@@ -62,6 +72,12 @@ struct Data {
   std::vector<double> composite_mass;
   std::vector<Vector3> composite_first_moment;
   std::vector<Matrix3> composite_inertia_O;
+  // gravity_torques works in body frames instead, without any world pose (docs/algorithms.md):
+  std::vector<Vector3>
+      composite_first_moment_B;           ///< subtree's m c about body i's origin, body i axes
+  std::vector<Vector3> gravity_B;         ///< the gravity vector g_i in body i's axes
+  std::vector<double> gravity_lin_B;      ///< S_B,lin . g_i
+  std::vector<Vector3> gravity_moment_B;  ///< g_i x S_B,ang
   std::vector<Matrix6> Ic;       ///< composite spatial inertia of each subtree (world, origin)
   std::vector<Matrix6> Bc;       ///< composite v x* I of each subtree (for C)
   std::vector<Vector6> Sdot;     ///< time derivative of S

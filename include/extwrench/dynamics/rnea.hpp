@@ -43,11 +43,16 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
 /// The same reading expressed in the world frame (moment still about O_s).
 [[nodiscard]] Vector6 sensor_reading_world(const Data& data, const Vector3& p_WS);
 
-/// Bias torques c(q, dq) = C(q, dq) dq + g(q) into data.tau.
+/// Bias torques c(q, dq) = C(q, dq) dq + g(q) into data.tau: rnea at ddq = 0 (it leaves what
+/// rnea leaves, not the world mass properties of forward_kinematics). q, dq: (n).
 const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                             const Eigen::Ref<const VectorX>& dq);
 
-/// Gravity torques g(q) into data.gravity_torque.
+/// Gravity torques g(q) into data.gravity_torque: an O(n) pass over the subtrees' masses and
+/// first moments in body frames (docs/algorithms.md), without velocities, inertia tensors or
+/// world poses. Writes only data.gravity_torque and the scratch gravity_B, gravity_lin_B,
+/// gravity_moment_B, composite_mass, composite_first_moment_B, sin_q, cos_q (not data.tau, X_WB
+/// or S). Armature does not enter g. q: (n).
 const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q);
 
 /// Coriolis matrix C(q, dq) into data.C, the factorization with B_dot = C + C^T
