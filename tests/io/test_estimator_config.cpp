@@ -86,6 +86,22 @@ TEST(EstimatorConfig, GravityOfTheConfigOverridesTheRobotFile) {
   EXPECT_TRUE(c.robot.model.gravity.isApprox(Vector3(9.81, 0, 0)));
 }
 
+// fuzz_estimator_config's finding (tests/data/fuzz_findings/estimator_config/): a sensor roll
+// of 5 rad was written with a pitch of "-0", read back as +0, so the second writing differed.
+TEST(EstimatorConfig, WrittenSensorPoseIsAFixedPointOfWritingAndReading) {
+  for (const char* rpy : {"[5, 0, 0]", "[0, 0, 5]", "[0, 0, 0]"}) {
+    const EstimatorConfig a = load_estimator_config_string(
+        std::string("robot: ../../../models/paper_arm.urdf\nsensor: {type: ft, pose: {xyz: [0, 0, "
+                    "-0.31], rpy: ") +
+            rpy + "}}\n",
+        kDir / "pose.yaml");
+    const std::string once = to_yaml(a, kDir);
+    const std::string twice = to_yaml(load_estimator_config_string(once, kDir / "w.yaml"), kDir);
+    EXPECT_EQ(once, twice) << "rpy " << rpy;
+    EXPECT_EQ(once.find("-0,"), std::string::npos) << once;
+  }
+}
+
 TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
   for (const char* file : {"paper_ft.yaml", "known_point_force.yaml", "minimal_none.yaml"}) {
     const EstimatorConfig a = load_estimator_config(kDir / file);
