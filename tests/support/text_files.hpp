@@ -9,8 +9,43 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace extwrench::test {
+
+/// One CSV line split at every comma (the tests' own splitting: the logs and estimates the
+/// tools write have no quoted cells); a trailing comma gives a trailing empty cell.
+inline std::vector<std::string> split_cells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::stringstream cs(line);
+  std::string cell;
+  while (std::getline(cs, cell, ',')) cells.push_back(cell);
+  if (!line.empty() && line.back() == ',') cells.emplace_back();
+  return cells;
+}
+
+/// The CSV text with the columns whose names start with any of `prefixes` removed.
+inline std::string drop_columns(const std::string& csv, const std::vector<std::string>& prefixes) {
+  std::istringstream in(csv);
+  std::string line, out;
+  std::vector<bool> keep;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> cells = split_cells(line);
+    if (keep.empty()) {
+      for (const auto& c : cells) {
+        bool k = true;
+        for (const auto& p : prefixes) k = k && c.rfind(p, 0) != 0;
+        keep.push_back(k);
+      }
+    }
+    std::string row;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (i < keep.size() && keep[i]) row += (row.empty() ? "" : ",") + cells[i];
+    }
+    out += row + "\n";
+  }
+  return out;
+}
 
 /// The file's bytes; empty when it cannot be read.
 inline std::string read_text(const std::filesystem::path& path) {

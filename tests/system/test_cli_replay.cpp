@@ -33,34 +33,6 @@ using CliRun = test::CliResult;
 
 bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
-// The CSV text with the columns whose names start with any of `prefixes` removed (the test's
-// own splitting: the logs written by simulate have no quoted cells).
-std::string drop_columns(const std::string& csv, const std::vector<std::string>& prefixes) {
-  std::istringstream in(csv);
-  std::string line, out;
-  std::vector<bool> keep;
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::stringstream cs(line);
-    std::string cell;
-    while (std::getline(cs, cell, ',')) cells.push_back(cell);
-    if (!line.empty() && line.back() == ',') cells.emplace_back();
-    if (keep.empty()) {
-      for (const auto& c : cells) {
-        bool k = true;
-        for (const auto& p : prefixes) k = k && c.rfind(p, 0) != 0;
-        keep.push_back(k);
-      }
-    }
-    std::string row;
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-      if (i < keep.size() && keep[i]) row += (row.empty() ? "" : ",") + cells[i];
-    }
-    out += row + "\n";
-  }
-  return out;
-}
-
 // One short run of the paper scenario (through the singularity at t = 2 s) shared by the tests.
 class RealLog : public ::testing::Test {
  protected:
@@ -90,7 +62,8 @@ class RealLog : public ::testing::Test {
     const auto bad = scenario.find("no_sensor: {force_rms_outside");
     ASSERT_NE(bad, std::string::npos);
     write_text(dir_ / "bad_target.yaml", scenario.replace(bad, 9, "nosuch   "));
-    write_text(dir_ / "robot_log.csv", drop_columns(read_text(dir_ / "sim/log.csv"), {"true_"}));
+    write_text(dir_ / "robot_log.csv",
+               test::drop_columns(read_text(dir_ / "sim/log.csv"), {"true_"}));
   }
   static void TearDownTestSuite() { fs::remove_all(dir_); }
 

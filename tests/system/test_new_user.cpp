@@ -76,11 +76,7 @@ struct Table {
     std::string line;
     bool header = true;
     while (std::getline(in, line)) {
-      std::vector<std::string> cells;
-      std::stringstream cs(line);
-      std::string cell;
-      while (std::getline(cs, cell, ',')) cells.push_back(cell);
-      if (!line.empty() && line.back() == ',') cells.emplace_back();
+      std::vector<std::string> cells = test::split_cells(line);
       if (header) {
         for (std::size_t i = 0; i < cells.size(); ++i) t.column[cells[i]] = i;
         header = false;
@@ -99,29 +95,6 @@ struct Table {
     return s.empty() ? std::nan("") : std::strtod(s.c_str(), nullptr);
   }
 };
-
-// The log without its truth columns (what a robot records).
-std::string without_truth(const std::string& csv) {
-  std::istringstream in(csv);
-  std::string line, out;
-  std::vector<bool> keep;
-  while (std::getline(in, line)) {
-    std::vector<std::string> cells;
-    std::stringstream cs(line);
-    std::string cell;
-    while (std::getline(cs, cell, ',')) cells.push_back(cell);
-    if (!line.empty() && line.back() == ',') cells.emplace_back();
-    if (keep.empty()) {
-      for (const auto& c : cells) keep.push_back(c.rfind("true_", 0) != 0);
-    }
-    std::string row;
-    for (std::size_t i = 0; i < cells.size(); ++i) {
-      if (i < keep.size() && keep[i]) row += (row.empty() ? "" : ",") + cells[i];
-    }
-    out += row + "\n";
-  }
-  return out;
-}
 
 // A PNG file: the signature, and an image header with a plausible size.
 ::testing::AssertionResult is_png(const fs::path& path) {
@@ -309,7 +282,8 @@ TEST_P(NewUser, InfoDynamicsSimulateAndEstimateOnALogWithoutTruthGiveNoSilentWro
   // estimate: the user's own configuration (the robot file as given, the Panda's fingers locked
   // in it) on seed 1's log without its truth columns.
   const Table truth = Table::read(sim / "seed_1/log.csv");
-  write_text(dir_ / "robot_log.csv", without_truth(read_text(sim / "seed_1/log.csv")));
+  write_text(dir_ / "robot_log.csv",
+             test::drop_columns(read_text(sim / "seed_1/log.csv"), {"true_"}));
   ASSERT_FALSE(contains(read_text(dir_ / "robot_log.csv"), "true_"));
   for (const std::string& type : kSensorTypes) {
     SCOPED_TRACE("estimate, " + type);
