@@ -321,9 +321,7 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   }
   y << "gravity: " << list3(model.gravity) << '\n';
   y << "sensor:\n  type: " << to_string(o.sensor.type) << '\n';
-  // + 0.0 turns a -0 angle (atan2 of a -0 entry) into 0: the rotation read back from "-0" has a
-  // +0 entry there, so the text would not be a fixed point (found by fuzz_estimator_config).
-  const Vector3 rpy = (rpy_from_rotation(o.sensor.X_WS.rotation).array() + 0.0).matrix();
+  const Vector3 rpy = rpy_from_rotation(o.sensor.X_WS.rotation);
   y << "  pose: {xyz: " << list3(o.sensor.X_WS.translation) << ", rpy: " << list3(rpy) << "}\n";
   y << "  tare: " << o.sensor.tare_samples << '\n';
   if (!o.sensor.bias_S.isZero(0.0))

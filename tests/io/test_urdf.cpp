@@ -1,11 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <numbers>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "extwrench/io/urdf_writer.hpp"
 #include "support/io_test_util.hpp"
 #include "support/random.hpp"
 
@@ -134,6 +136,32 @@ TEST(Urdf, GravityCanBeOverridden) {
   EXPECT_TRUE(load_robot(file, o).model.gravity.isApprox(Vector3(0, 9.81, 0)));
   EXPECT_TRUE(load_robot(test::project_models() / "paper_arm.yaml", o)
                   .model.gravity.isApprox(Vector3(0, 9.81, 0)));
+}
+
+// A rotation about one axis has -0 entries: atan2 turned them into -0 angles, which the written
+// URDF (and every configuration and message) carried as "-0" although they read back as +0.
+TEST(Urdf, WrittenAnglesAreNeverNegativeZero) {
+  for (int a = 0; a < 3; ++a) {
+    const Vector3 axis = Vector3::Unit(a);
+    const Matrix3 r = Eigen::AngleAxisd(5.0, axis).toRotationMatrix();
+    const Vector3 rpy = rpy_from_rotation(r);
+    for (int k = 0; k < 3; ++k) {
+      if (k == a) continue;  // the angle itself, 5 - 2π
+      EXPECT_EQ(rpy[k], 0.0) << axis.transpose();
+      EXPECT_FALSE(std::signbit(rpy[k])) << axis.transpose();
+    }
+    // Still the same rotation.
+    const Matrix3 back = (Eigen::AngleAxisd(rpy.z(), Vector3::UnitZ()) *
+                          Eigen::AngleAxisd(rpy.y(), Vector3::UnitY()) *
+                          Eigen::AngleAxisd(rpy.x(), Vector3::UnitX()))
+                             .toRotationMatrix();
+    EXPECT_TRUE(back.isApprox(r, 1e-14)) << axis.transpose();
+  }
+  Model m = load_robot(test::project_models() / "paper_arm.urdf", no_meshes()).model;
+  m.joints[1].placement.rotation = Eigen::AngleAxisd(5.0, Vector3::UnitX()).toRotationMatrix();
+  const std::string text = write_urdf_string(m, GeometryModel{});
+  EXPECT_EQ(text.find("-0 "), std::string::npos) << text;
+  EXPECT_EQ(text.find("-0\""), std::string::npos) << text;
 }
 
 // ---- the shared validation models ------------------------------------------------------------

@@ -72,12 +72,14 @@ struct Pose {
   }
 };
 
-/// Rotation matrix to fixed-axis roll, pitch, yaw (URDF convention).
+/// Rotation matrix to fixed-axis roll, pitch, yaw (URDF convention). Never -0: atan2 of a -0
+/// entry gives -0, which text would carry ("-0") although reading it back gives the same
+/// rotation with a +0 entry, so written poses would not be a fixed point (+ 0.0 makes it +0).
 inline Vector3 rpy_from_rotation(const Matrix3& r) {
   const double pitch = std::atan2(-r(2, 0), std::hypot(r(0, 0), r(1, 0)));
   const double roll = std::atan2(r(2, 1), r(2, 2));
   const double yaw = std::atan2(r(1, 0), r(0, 0));
-  return {roll, pitch, yaw};
+  return {roll + 0.0, pitch + 0.0, yaw + 0.0};
 }
 
 }  // namespace extwrench
