@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/csv.hpp"
 #include "figure_script.hpp"
 
 namespace extwrench {
@@ -82,21 +83,48 @@ std::string target_lines(const Scenario& s, const std::string& metric, const std
   return t.str();
 }
 
+// The title, and when there is a second window a smaller second line saying why the two differ:
+// the full window holds the singularity crossings, where a scheme without a base sensor cannot
+// resolve the force (the paper's Figs. 8-9). Double-quoted: gnuplot reads "\n" there only.
+std::string summary_title(const Scenario& s) {
+  const auto quoted = [](const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+      if (c == '\\' || c == '"') out += '\\';
+      out += c;
+    }
+    return out;
+  };
+  std::string title = "\"" + quoted(enhanced("Across seeds — " + s.source.filename().string()));
+  if (s.singularity_half_width > 0.0) {
+    title += "\\n{/*0.8 " +
+             quoted(enhanced("dashed, open points: without ±" +
+                             CsvWriter::format(s.singularity_half_width) +
+                             " s around each crossing of cond(J of O")) +
+             "_{" + quoted(enhanced(s.singularity_link)) + "}" +
+             quoted(enhanced(") > " + CsvWriter::format(s.singularity_threshold))) + "}";
+  }
+  return title + "\"";
+}
+
 std::string summary_script(const Scenario& s, const Figure& f, FigureFormat format) {
   std::ostringstream g;
   g << gnuplot_preamble(f.output, format, 1000, 800)
     << "set key outside right top vertical samplen 2\nset multiplot layout 2,1 title "
-    << gnuplot_quote(enhanced("Across seeds — " + s.source.filename().string()))
+    << summary_title(s)
     << "\nset lmargin 10\nset rmargin 26\nset xlabel 'seed'\nset xtics 1\nset offsets 0.3, 0.3, "
-       "0, 0\nset yrange [0:*]\n";
+       "0, 0\nset autoscale xfix\nset yrange [0:*]\n";
   const auto plot = [&](const std::vector<std::pair<int, std::string>>& columns) {
     std::string list;
     for (std::size_t i = 0; i < s.schemes.size(); ++i) {
       for (const auto& [column, suffix] : columns) {
         list += (list.empty() ? "" : ", ") + std::string("'summary.txt' index ") +
-                std::to_string(i) + " using 1:" + std::to_string(column) +
-                " with linespoints lw 2 pt 7 lt " + std::to_string(i + 1) +
-                (suffix.empty() ? "" : " dt 2") + " title " +
+                std::to_string(i) + " using 1:" + std::to_string(column) + " with linespoints lt " +
+                std::to_string(i + 1) +
+                // The second window: thin, dashed, open points, so a scheme whose two
+                // windows agree (a base sensor does not mind the singularity) shows a ring
+                // around each point instead of hiding one curve under the other.
+                (suffix.empty() ? " lw 2 pt 7" : " lw 1 dt 2 pt 6 ps 1.6") + " title " +
                 gnuplot_quote(enhanced(s.schemes[i].name + suffix));
       }
     }
