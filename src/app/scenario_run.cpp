@@ -213,7 +213,8 @@ GeometryModel geometry_with_mesh_files(const GeometryModel& geometry,
     if (!file_mesh) {
       std::string name = "mesh" + std::to_string(written.size()) + "_";
       for (const char c : shape.mesh->path)
-        name += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-') ? c : '_';
+        name +=
+            (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-') ? c : '_';
       outputs.create_directories(dir / "meshes");
       const std::filesystem::path file = dir / "meshes" / (name + ".obj");
       {

@@ -299,17 +299,19 @@ Obstacle parse_obstacle(const YamlReader& y, const YAML::Node& node, const std::
       o.size.head<2>() = y.vector(size, k + ".size", 2, &length);
       break;
   }
-  if (!(o.size.array() >= 0.0).all() || (o.shape == Obstacle::Shape::kBox ? o.size.minCoeff() : o.size[0]) <= 0.0)
+  if (!(o.size.array() >= 0.0).all() ||
+      (o.shape == Obstacle::Shape::kBox ? o.size.minCoeff() : o.size[0]) <= 0.0)
     y.fail(size, k + ".size", "sizes must be > 0 [m]");
   if (const YAML::Node m = node["motion"]) {
     const std::string km = k + ".motion";
     y.only_keys(m, km, {"type", "amplitude", "frequency", "phase", "velocity", "start", "end"});
-    const std::size_t type = y.one_of(y.required(m, km, "type"), km + ".type",
-                                      {"fixed", "sinusoidal", "linear"});
+    const std::size_t type =
+        y.one_of(y.required(m, km, "type"), km + ".type", {"fixed", "sinusoidal", "linear"});
     o.motion = static_cast<Obstacle::Motion>(type);
     const auto forbid = [&](std::initializer_list<const char*> keys, const char* what) {
       for (const char* key : keys) {
-        if (m[key]) y.fail(m[key], km + "." + key, std::string("not a key of a ") + what + " motion");
+        if (m[key])
+          y.fail(m[key], km + "." + key, std::string("not a key of a ") + what + " motion");
       }
     };
     if (o.motion == Obstacle::Motion::kSinusoidal) {
@@ -317,7 +319,8 @@ Obstacle parse_obstacle(const YamlReader& y, const YAML::Node& node, const std::
       o.amplitude = y.vector3(y.required(m, km, "amplitude"), km + ".amplitude");
       o.frequency = y.number_in(y.required(m, km, "frequency"), km + ".frequency",
                                 {0.0, 1e3, true, "in (0, 1000] Hz"});
-      if (m["phase"]) o.phase = y.number_in(m["phase"], km + ".phase", {-1e3, 1e3, false, "finite"});
+      if (m["phase"])
+        o.phase = y.number_in(m["phase"], km + ".phase", {-1e3, 1e3, false, "finite"});
     } else if (o.motion == Obstacle::Motion::kLinear) {
       forbid({"amplitude", "frequency", "phase"}, "linear");
       o.velocity = y.vector3(y.required(m, km, "velocity"), km + ".velocity");

@@ -54,8 +54,9 @@ std::string obstacle_geom(const Obstacle& o, bool in_body) {
   // priority 1: MuJoCo takes the obstacle's friction, solref and solimp for its contacts with
   // the robot (instead of mixing them with the robot geom's).
   return std::string("<geom name=\"") + kSceneObstaclePrefix + o.name + "\" type=\"" + type +
-         "\" size=\"" + size + "\" " + (in_body ? "" : "POSE ") + "contype=\"1\" conaffinity=\"1\" " +
-         "priority=\"1\" condim=\"" + std::to_string(o.condim) + "\" friction=\"" +
+         "\" size=\"" + size + "\" " + (in_body ? "" : "POSE ") +
+         "contype=\"1\" conaffinity=\"1\" " + "priority=\"1\" condim=\"" +
+         std::to_string(o.condim) + "\" friction=\"" +
          numbers({o.friction.x(), o.friction.y(), o.friction.z()}) + "\" solref=\"" +
          numbers({o.solref.x(), o.solref.y()}) + "\" solimp=\"" +
          numbers({si[0], si[1], si[2], si[3], si[4]}) + "\" rgba=\"0.8 0.35 0.3 1\"/>";
@@ -67,9 +68,8 @@ mjModel* compile(const std::string& xml, const std::filesystem::path& robot_path
                  const std::string& label) {
   auto* vfs = new mjVFS;  // large: not on the stack
   mj_defaultVFS(vfs);
-  const std::filesystem::path name =
-      std::filesystem::absolute(robot_path).parent_path() /
-      (robot_path.stem().string() + ".extwrench_scene.xml");
+  const std::filesystem::path name = std::filesystem::absolute(robot_path).parent_path() /
+                                     (robot_path.stem().string() + ".extwrench_scene.xml");
   mjModel* m = nullptr;
   char error[1000] = "";
   if (mj_makeEmptyFileVFS(vfs, name.string().c_str(), static_cast<int>(xml.size()) + 1) == 0) {
@@ -122,9 +122,9 @@ std::string scene_mjcf(const Scenario& s, const Pose& X_WS, const Pose& X_mj_roo
                            pose_attributes(X_WS) + " size=\"0.005\"/>";
   const std::string& root = s.robot.model.bodies[0].name;
   std::smatch match;
-  const std::regex body_tag("<body\\b[^>]*\\bname\\s*=\\s*[\"']" +
-                            std::regex_replace(root, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
-                            "[\"'][^>]*>");
+  const std::regex body_tag(
+      "<body\\b[^>]*\\bname\\s*=\\s*[\"']" +
+      std::regex_replace(root, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") + "[\"'][^>]*>");
   const std::regex worldbody_tag("<worldbody\\s*>");
   std::string obstacles;
   for (const Obstacle& o : s.obstacles) {
@@ -159,14 +159,14 @@ std::string scene_mjcf(const Scenario& s, const Pose& X_WS, const Pose& X_mj_roo
   std::string excludes;
   for (std::size_t a = 0; a < robot_bodies.size(); ++a) {
     for (std::size_t b = a + 1; b < robot_bodies.size(); ++b) {
-      excludes += "    <exclude body1=\"" + robot_bodies[a] + "\" body2=\"" + robot_bodies[b] + "\"/>\n";
+      excludes +=
+          "    <exclude body1=\"" + robot_bodies[a] + "\" body2=\"" + robot_bodies[b] + "\"/>\n";
     }
   }
   if (!excludes.empty()) xml.insert(end, "  <contact>\n" + excludes + "  </contact>\n");
-  xml.insert(end, std::string("  <sensor>\n    <force name=\"") + kSceneForceSensor +
-                      "\" site=\"" + kSceneSensorSite + "\"/>\n    <torque name=\"" +
-                      kSceneTorqueSensor + "\" site=\"" + kSceneSensorSite +
-                      "\"/>\n  </sensor>\n");
+  xml.insert(end, std::string("  <sensor>\n    <force name=\"") + kSceneForceSensor + "\" site=\"" +
+                      kSceneSensorSite + "\"/>\n    <torque name=\"" + kSceneTorqueSensor +
+                      "\" site=\"" + kSceneSensorSite + "\"/>\n  </sensor>\n");
   return xml;
 }
 
@@ -207,7 +207,8 @@ MujocoSimulator::MujocoSimulator(const Scenario& s, sim::ComputedTorqueControlle
   bridge_options.torque_sensor = kSceneTorqueSensor;
   bridge_ = std::make_unique<MujocoBridge>(m_, model_, bridge_options);
   for (int i = 1; i <= n; ++i) {
-    const int j = mj_name2id(m_, mjOBJ_JOINT, model_.joints[static_cast<std::size_t>(i)].name.c_str());
+    const int j =
+        mj_name2id(m_, mjOBJ_JOINT, model_.joints[static_cast<std::size_t>(i)].name.c_str());
     qpos_adr_.push_back(m_->jnt_qposadr[j]);
     dof_adr_.push_back(m_->jnt_dofadr[j]);
   }
@@ -220,7 +221,8 @@ MujocoSimulator::MujocoSimulator(const Scenario& s, sim::ComputedTorqueControlle
     const char* name = mj_id2name(m_, mjOBJ_BODY, b);
     const auto frame = name != nullptr ? model_.find_frame(name) : std::nullopt;
     if (!frame) continue;
-    int& mine = mj_body_of_body_[static_cast<std::size_t>(model_.frames[static_cast<std::size_t>(*frame)].body)];
+    int& mine = mj_body_of_body_[static_cast<std::size_t>(
+        model_.frames[static_cast<std::size_t>(*frame)].body)];
     if (mine < 0) mine = b;
   }
   for (sim::ForceProfile& f : config_.forces) {

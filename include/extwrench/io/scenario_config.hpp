@@ -54,7 +54,7 @@ struct Obstacle {
   double end = 0.0;
   // MuJoCo's contact parameters of the geom (defaults: MuJoCo's own).
   Vector3 friction{1.0, 0.005, 0.0001};  ///< sliding, torsional, rolling
-  Eigen::Vector2d solref{0.02, 1.0};            ///< time constant [s], damping ratio
+  Eigen::Vector2d solref{0.02, 1.0};     ///< time constant [s], damping ratio
   VectorX solimp = (VectorX(5) << 0.9, 0.95, 0.001, 0.5, 2.0).finished();
   int condim = 3;
   int line = 0;  ///< where it is defined in the scenario
