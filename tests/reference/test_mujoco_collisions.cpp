@@ -274,7 +274,7 @@ schemes:
       {replaced(good, "pose: {xyz: [1, 0, 0]}", "solimp: [0.9, 1.2, 0.001, 0.5, 2]"),
        ":6: obstacles[0].solimp: expected [dmin, dmax, width, midpoint, power]"},
       {replaced(good, "engine: mujoco", "engine: mujoco\nlocked_joints: {joint7: 0}"),
-       "locked_joints: not with engine: mujoco"},
+       ":3: locked_joints: not with engine: mujoco"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const fs::path path = dir_ / ("bad" + std::to_string(i) + ".yaml");
