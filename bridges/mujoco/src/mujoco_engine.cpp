@@ -4,6 +4,7 @@
 #include <mujoco/mujoco.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <regex>
 #include <sstream>
