@@ -7,6 +7,7 @@
 #include "extwrench/core/error.hpp"
 #ifdef EXTWRENCH_HAVE_MUJOCO
 #include "extwrench/bridges/mjcf.hpp"
+#include "extwrench/bridges/mujoco_engine.hpp"
 #endif
 
 #ifndef EXTWRENCH_VERSION
@@ -51,7 +52,8 @@ int main(int argc, char** argv) {
   app.footer(kFooter);
 
 #ifdef EXTWRENCH_HAVE_MUJOCO
-  extwrench::mujoco::register_mjcf_loader();  // load_robot reads MJCF (docs/mujoco.md)
+  extwrench::mujoco::register_mjcf_loader();    // load_robot reads MJCF (docs/mujoco.md)
+  extwrench::mujoco::register_mujoco_engine();  // scenarios with engine: mujoco
 #endif
   // One line per subcommand; each lives in its own file.
   extwrench::cli::register_info(app);

@@ -1,10 +1,12 @@
 #include "extwrench/app/scenario_run.hpp"
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -14,6 +16,7 @@
 #include "extwrench/io/csv.hpp"
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/log.hpp"
+#include "extwrench/io/number_text.hpp"
 #include "extwrench/io/urdf_writer.hpp"
 #include "extwrench/sim/perturb.hpp"
 #include "progress.hpp"
@@ -79,8 +82,19 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   const Model& model = s.robot.model;
   sim::SimulationConfig sc = s.simulation;
   sc.noise_seed = 2 * r.seed + 1;
-  sim::Simulator simulator(model, sim::ComputedTorqueController(believed, s.trajectory, s.gains),
-                           sc);
+  sim::ComputedTorqueController controller(believed, s.trajectory, s.gains);
+  std::unique_ptr<sim::SampleSource> source;
+  if (s.engine == Scenario::Engine::kMujoco) {
+    const MujocoEngine engine = mujoco_engine();
+    if (engine == nullptr) {
+      throw Error(s.source.string() +
+                  ": engine: mujoco, but no MuJoCo engine is registered in this program");
+    }
+    source = engine(s, std::move(controller), sc);
+  } else {
+    source = std::make_unique<sim::Simulator>(model, std::move(controller), sc);
+  }
+  sim::SampleSource& simulator = *source;
   LogLayout layout;
   layout.n = model.nq();
   layout.velocity = s.log_velocity;
@@ -185,6 +199,51 @@ std::filesystem::path seed_dir(const Scenario& s, std::uint64_t seed,
   return s.seeds.size() == 1 ? out_dir : out_dir / ("seed_" + std::to_string(seed));
 }
 
+// Meshes that are not files (an MJCF's: MuJoCo's compiled vertices) written as OBJ files in
+// DIR/meshes/, so that model_estimator.urdf names files `extwrench estimate` can read.
+GeometryModel geometry_with_mesh_files(const GeometryModel& geometry,
+                                       const std::filesystem::path& dir, OutputFiles& outputs) {
+  GeometryModel out = geometry;
+  std::map<const TriangleMesh*, std::shared_ptr<const TriangleMesh>> written;
+  for (CollisionShape& shape : out.shapes) {
+    if (shape.type != ShapeType::kMesh || !shape.mesh) continue;
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(shape.mesh->path, ec)) continue;
+    std::shared_ptr<const TriangleMesh>& file_mesh = written[shape.mesh.get()];
+    if (!file_mesh) {
+      std::string name = "mesh" + std::to_string(written.size()) + "_";
+      for (const char c : shape.mesh->path)
+        name +=
+            (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '_' || c == '-') ? c : '_';
+      outputs.create_directories(dir / "meshes");
+      const std::filesystem::path file = dir / "meshes" / (name + ".obj");
+      {
+        const std::filesystem::path partial = outputs.stage(file);
+        std::ofstream obj(partial);
+        if (!obj) throw Error(partial.string() + ": cannot create the file");
+        obj << "# " << shape.mesh->path << " (written by extwrench simulate)\n";
+        const auto& v = shape.mesh->vertices;
+        for (Eigen::Index i = 0; i < v.cols(); ++i) {
+          obj << "v " << format_number(v(0, i)) << ' ' << format_number(v(1, i)) << ' '
+              << format_number(v(2, i)) << '\n';
+        }
+        const auto& f = shape.mesh->triangles;
+        for (Eigen::Index i = 0; i < f.cols(); ++i)
+          obj << "f " << f(0, i) + 1 << ' ' << f(1, i) + 1 << ' ' << f(2, i) + 1 << '\n';
+        obj.flush();
+        if (!obj) throw Error(partial.string() + ": write failed (disk full?)");
+      }
+      outputs.commit(file);
+      auto copy = std::make_shared<TriangleMesh>(*shape.mesh);
+      copy->path = std::filesystem::absolute(file).string();
+      file_mesh = std::move(copy);
+    }
+    shape.mesh = file_mesh;
+    shape.scale = Vector3::Ones();
+  }
+  return out;
+}
+
 // A seed's simulation: its model, configurations and log, and the metric windows they give.
 void simulate_job(const Scenario& s, int singular_body, bool progress, OutputFiles& outputs,
                   SeedJob& job) {
@@ -193,7 +252,8 @@ void simulate_job(const Scenario& s, int singular_body, bool progress, OutputFil
   // Two independent streams per seed: the model error and the sensor noise.
   const Model believed = sim::perturb_model(s.robot.model, s.model_error, 2 * r.seed);
   const std::filesystem::path urdf = r.dir / "model_estimator.urdf";
-  write_urdf(outputs.stage(urdf), believed, s.robot.geometry);
+  write_urdf(outputs.stage(urdf), believed,
+             geometry_with_mesh_files(s.robot.geometry, r.dir, outputs));
   outputs.commit(urdf);
   job.configs = write_scheme_configs(s, r.dir, outputs);
   simulate_seed(s, believed, singular_body, progress, outputs, r);

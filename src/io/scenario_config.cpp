@@ -3,6 +3,10 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <numbers>
 #include <string>
 
 #include "detail/yaml_reader.hpp"
@@ -270,6 +274,123 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
   }
 }
 
+// One obstacle of `obstacles:` (engine: mujoco).
+Obstacle parse_obstacle(const YamlReader& y, const YAML::Node& node, const std::string& k) {
+  y.only_keys(node, k,
+              {"name", "type", "pose", "size", "motion", "friction", "solref", "solimp", "condim"});
+  Obstacle o;
+  o.line = node.Mark().line + 1;
+  o.name = y.string(y.required(node, k, "name"), k + ".name");
+  if (o.name.find_first_of(" \t\"<>&'") != std::string::npos)
+    y.fail(node["name"], k + ".name", "use letters, digits, '_', '-' or '.'");
+  o.shape = static_cast<Obstacle::Shape>(
+      y.one_of(y.required(node, k, "type"), k + ".type", {"box", "sphere", "capsule"}));
+  if (node["pose"]) o.pose = y.pose(node["pose"], k + ".pose");
+  const YAML::Node size = y.required(node, k, "size");
+  const Range length{0.0, 1e3, true, "in (0, 1000] m"};
+  switch (o.shape) {
+    case Obstacle::Shape::kBox:
+      o.size = y.vector(size, k + ".size", 3, &length);
+      break;
+    case Obstacle::Shape::kSphere:
+      o.size[0] = y.vector(size, k + ".size", 1, &length)[0];
+      break;
+    case Obstacle::Shape::kCapsule:
+      o.size.head<2>() = y.vector(size, k + ".size", 2, &length);
+      break;
+  }
+  if (!(o.size.array() >= 0.0).all() ||
+      (o.shape == Obstacle::Shape::kBox ? o.size.minCoeff() : o.size[0]) <= 0.0)
+    y.fail(size, k + ".size", "sizes must be > 0 [m]");
+  if (const YAML::Node m = node["motion"]) {
+    const std::string km = k + ".motion";
+    y.only_keys(m, km, {"type", "amplitude", "frequency", "phase", "velocity", "start", "end"});
+    const std::size_t type =
+        y.one_of(y.required(m, km, "type"), km + ".type", {"fixed", "sinusoidal", "linear"});
+    o.motion = static_cast<Obstacle::Motion>(type);
+    const auto forbid = [&](std::initializer_list<const char*> keys, const char* what) {
+      for (const char* key : keys) {
+        if (m[key])
+          y.fail(m[key], km + "." + key, std::string("not a key of a ") + what + " motion");
+      }
+    };
+    if (o.motion == Obstacle::Motion::kSinusoidal) {
+      forbid({"velocity", "start", "end"}, "sinusoidal");
+      o.amplitude = y.vector3(y.required(m, km, "amplitude"), km + ".amplitude");
+      o.frequency = y.number_in(y.required(m, km, "frequency"), km + ".frequency",
+                                {0.0, 1e3, true, "in (0, 1000] Hz"});
+      if (m["phase"])
+        o.phase = y.number_in(m["phase"], km + ".phase", {-1e3, 1e3, false, "finite"});
+    } else if (o.motion == Obstacle::Motion::kLinear) {
+      forbid({"amplitude", "frequency", "phase"}, "linear");
+      o.velocity = y.vector3(y.required(m, km, "velocity"), km + ".velocity");
+      o.end = std::numeric_limits<double>::infinity();
+      if (m["start"]) o.start = y.number_in(m["start"], km + ".start", non_negative());
+      if (m["end"]) o.end = y.number(m["end"], km + ".end");
+      if (!(o.end > o.start)) y.fail(m, km, "end must be after start");
+    } else {
+      forbid({"amplitude", "frequency", "phase", "velocity", "start", "end"}, "fixed");
+    }
+  }
+  const Range positive_value{0.0, 1e300, true, "> 0"};
+  if (node["friction"]) {
+    o.friction = y.vector3(node["friction"], k + ".friction");
+    if (!(o.friction.array() >= 0.0).all() || !(o.friction[0] > 0.0))
+      y.fail(node["friction"], k + ".friction",
+             "expected [sliding > 0, torsional >= 0, rolling >= 0]");
+  }
+  if (node["solref"]) o.solref = y.vector(node["solref"], k + ".solref", 2, &positive_value);
+  if (node["solimp"]) {
+    o.solimp = y.vector(node["solimp"], k + ".solimp", 5);
+    const VectorX& v = o.solimp;
+    if (!(v[0] > 0.0 && v[0] < 1.0 && v[1] > 0.0 && v[1] < 1.0 && v[2] > 0.0 && v[3] > 0.0 &&
+          v[3] < 1.0 && v[4] >= 1.0)) {
+      y.fail(node["solimp"], k + ".solimp",
+             "expected [dmin, dmax, width, midpoint, power]: dmin, dmax, midpoint in (0, 1), "
+             "width > 0, power >= 1");
+    }
+  }
+  if (node["condim"]) {
+    const auto c = y.integer(node["condim"], k + ".condim", {1, 6, false, "1, 3, 4 or 6"});
+    if (c == 2 || c == 5) y.fail(node["condim"], k + ".condim", "expected 1, 3, 4 or 6");
+    o.condim = static_cast<int>(c);
+  }
+  return o;
+}
+
+// engine: rigid | mujoco, and the obstacles of a MuJoCo scene.
+void parse_engine(const YamlReader& y, const YAML::Node& root, Scenario& s) {
+  if (const YAML::Node e = root["engine"]) {
+    s.engine = y.one_of(e, "engine", {"rigid", "mujoco"}) == 1 ? Scenario::Engine::kMujoco
+                                                               : Scenario::Engine::kRigid;
+    if (s.engine == Scenario::Engine::kMujoco && mujoco_engine() == nullptr) {
+      y.fail(e, "engine",
+             "'mujoco' needs extwrench built with MuJoCo (Debian's libmujoco-dev) and a program "
+             "that registers it (extwrench::mujoco::register_mujoco_engine(); the extwrench "
+             "CLI does when it is built with MuJoCo)");
+    }
+  }
+  if (s.engine == Scenario::Engine::kMujoco && root["locked_joints"] &&
+      root["locked_joints"].size() > 0) {
+    y.fail(root["locked_joints"], "locked_joints",
+           "not with engine: mujoco (MuJoCo simulates every joint of the MJCF; give a file "
+           "without the joints, e.g. the Panda without its hand)");
+  }
+  const YAML::Node obstacles = root["obstacles"];
+  if (!obstacles) return;
+  if (s.engine != Scenario::Engine::kMujoco)
+    y.fail(obstacles, "obstacles", "obstacles are simulated by MuJoCo: set 'engine: mujoco'");
+  if (!obstacles.IsSequence()) y.fail(obstacles, "obstacles", "expected a list of obstacles");
+  for (std::size_t i = 0; i < obstacles.size(); ++i) {
+    const std::string k = YamlReader::item("obstacles", i);
+    Obstacle o = parse_obstacle(y, obstacles[i], k);
+    for (const Obstacle& other : s.obstacles) {
+      if (other.name == o.name) y.fail(obstacles[i]["name"], k + ".name", "'" + o.name + "' twice");
+    }
+    s.obstacles.push_back(std::move(o));
+  }
+}
+
 }  // namespace
 
 namespace {
@@ -281,7 +402,7 @@ Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& rob
   y.only_keys(root, "",
               {"robot", "locked_joints", "seed", "seeds", "duration", "sample_time", "substeps",
                "model_error", "trajectory", "controller", "forces", "sensors", "metrics", "figures",
-               "schemes"});
+               "schemes", "engine", "obstacles"});
   Scenario s;
   s.source = path;
   parse_robot(y, root, robot_options, s);
@@ -289,6 +410,7 @@ Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& rob
   const int n = model.nq();
   parse_seeds(y, root, s);
   parse_timing(y, root, s);
+  parse_engine(y, root, s);
   if (!root["trajectory"])
     y.fail(root, "trajectory", "missing (offset, amplitude, frequency, phase per joint)");
   parse_trajectory(y, root["trajectory"], n, s.trajectory);
@@ -315,6 +437,27 @@ Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& rob
 }
 
 }  // namespace
+
+namespace {
+std::atomic<MujocoEngine> g_mujoco_engine{nullptr};
+}  // namespace
+
+void set_mujoco_engine(MujocoEngine engine) noexcept { g_mujoco_engine.store(engine); }
+
+MujocoEngine mujoco_engine() noexcept { return g_mujoco_engine.load(); }
+
+Vector3 Obstacle::position(double t) const {
+  switch (motion) {
+    case Motion::kSinusoidal:
+      return pose.translation +
+             amplitude * std::sin(2.0 * std::numbers::pi * frequency * t + phase);
+    case Motion::kLinear:
+      return pose.translation + velocity * std::clamp(t - start, 0.0, end - start);
+    case Motion::kFixed:
+      break;
+  }
+  return pose.translation;
+}
 
 Scenario load_scenario(const std::filesystem::path& path, const LoadOptions& robot_options) {
   return io_detail::at_loader_boundary(path.string(),

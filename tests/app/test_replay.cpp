@@ -305,6 +305,14 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
       {"yaml_syntax", kGoodScenario + "forces: [\n", "YAML syntax error"},
       {"substeps", kGoodScenario + "substeps: 2.5\n",
        "substeps: expected a whole number in [1, 1000], got 2.5"},
+      {"engine_unknown", kGoodScenario + "engine: bullet\n",
+       ":9: engine: expected one of rigid, mujoco, got 'bullet'"},
+      // This program registers no MuJoCo engine (the CLI does when built with MuJoCo).
+      {"engine_mujoco_unavailable", kGoodScenario + "engine: mujoco\n",
+       ":9: engine: 'mujoco' needs extwrench built with MuJoCo"},
+      {"obstacles_without_engine",
+       kGoodScenario + "obstacles:\n  - {name: a, type: box, size: [1, 1, 1]}\n",
+       ":10: obstacles: obstacles are simulated by MuJoCo: set 'engine: mujoco'"},
   };
   const fs::path dir = temp_dir("badscenarios");
   for (const BadLog& c : cases) {

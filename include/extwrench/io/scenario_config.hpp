@@ -8,10 +8,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "extwrench/io/robot_loader.hpp"
+#include "extwrench/sim/sample_source.hpp"
 #include "extwrench/sim/simulator.hpp"
 
 namespace extwrench {
@@ -29,6 +31,51 @@ struct MetricTarget {
   int line = 0;
 };
 
+/// An obstacle of a MuJoCo scene (`obstacles:` with `engine: mujoco`, docs/simulation.md): a
+/// box, sphere or capsule in the world, fixed or moving (a MuJoCo mocap body), with the contact
+/// parameters MuJoCo uses for its contacts with the robot (the obstacle's geom has priority).
+struct Obstacle {
+  enum class Shape { kBox, kSphere, kCapsule };
+  enum class Motion { kFixed, kSinusoidal, kLinear };
+  std::string name;
+  Shape shape = Shape::kBox;
+  /// Pose at t = 0 in W (the robot's root frame); a capsule's axis is its z.
+  Pose pose = Pose::identity();
+  /// box: side lengths; sphere: (radius, 0, 0); capsule: (radius, length of the cylinder, 0) [m].
+  Vector3 size = Vector3::Zero();
+  Motion motion = Motion::kFixed;
+  /// kSinusoidal: p(t) = p0 + amplitude sin(2π frequency t + phase) [m, Hz, rad].
+  Vector3 amplitude = Vector3::Zero();
+  double frequency = 0.0;
+  double phase = 0.0;
+  /// kLinear: p(t) = p0 + velocity · clamp(t − start, 0, end − start) [m/s, s].
+  Vector3 velocity = Vector3::Zero();
+  double start = 0.0;
+  double end = 0.0;
+  // MuJoCo's contact parameters of the geom (defaults: MuJoCo's own).
+  Vector3 friction{1.0, 0.005, 0.0001};  ///< sliding, torsional, rolling
+  Eigen::Vector2d solref{0.02, 1.0};     ///< time constant [s], damping ratio
+  VectorX solimp = (VectorX(5) << 0.9, 0.95, 0.001, 0.5, 2.0).finished();
+  int condim = 3;
+  int line = 0;  ///< where it is defined in the scenario
+
+  /// The obstacle's origin in W at time t.
+  [[nodiscard]] Vector3 position(double t) const;
+};
+
+struct Scenario;
+
+/// What runs `engine: mujoco` (extwrench::mujoco's register_mujoco_engine() installs it): the
+/// closed loop of `scenario` in MuJoCo with this controller and the sensor models of `config`.
+using MujocoEngine = std::unique_ptr<sim::SampleSource> (*)(
+    const Scenario& scenario, sim::ComputedTorqueController controller,
+    const sim::SimulationConfig& config);
+
+/// Installs the MuJoCo engine (nullptr removes it). Without one, a scenario with
+/// `engine: mujoco` is an error naming the file and line.
+void set_mujoco_engine(MujocoEngine engine) noexcept;
+[[nodiscard]] MujocoEngine mujoco_engine() noexcept;
+
 struct Scenario {
   std::filesystem::path source;
   std::filesystem::path robot_path;
@@ -39,6 +86,11 @@ struct Scenario {
   std::vector<std::uint64_t> seeds{1};
   double model_error = 0.01;  ///< ± fraction of every dynamic parameter (docs/simulation.md)
   sim::SimulationConfig simulation;  ///< forces, sensors, duration, steps (noise seed per run)
+  /// `engine`: rigid (sim::Simulator, RK4) or mujoco (MuJoCo with `obstacles`, the robot an
+  /// MJCF file; run by the registered MujocoEngine).
+  enum class Engine { kRigid, kMujoco };
+  Engine engine = Engine::kRigid;
+  std::vector<Obstacle> obstacles;
   sim::SinusoidalTrajectory trajectory;
   sim::PidGains gains;
   double controller_omega = 0.0;  ///< when the gains come from `controller.omega`

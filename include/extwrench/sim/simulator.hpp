@@ -7,6 +7,7 @@
 #include "extwrench/core/sample.hpp"
 #include "extwrench/sim/controller.hpp"
 #include "extwrench/sim/force_profile.hpp"
+#include "extwrench/sim/sample_source.hpp"
 #include "extwrench/sim/sensor_model.hpp"
 
 namespace extwrench::sim {
@@ -44,18 +45,18 @@ bool rk4_step(const Model& model, std::span<const ForceProfile> forces, double t
 
 /// The simulated robot in closed loop with its controller. Each call to next() returns one
 /// sample (streaming: memory does not grow with the duration).
-class Simulator {
+class Simulator final : public SampleSource {
  public:
   /// `model` is the true robot (nominal parameters). Forces are resolved against it. Throws
   /// extwrench::Error on sizes that do not match the model, or a non-positive step.
   Simulator(const Model& model, ComputedTorqueController controller, SimulationConfig config);
 
   /// Number of samples the run produces.
-  [[nodiscard]] long num_samples() const { return num_samples_; }
+  [[nodiscard]] long num_samples() const override { return num_samples_; }
   /// Fills `out` with the next sample (measurements at t_k, the torque commanded at t_k and the
   /// truth at t_k), then integrates to t_{k+1}. Returns false when the run is over. Throws
   /// extwrench::Error if the simulation diverges (non-finite state, singular B).
-  bool next(Sample& out);
+  bool next(Sample& out) override;
 
   [[nodiscard]] const Model& model() const { return model_; }
   [[nodiscard]] const SimulationConfig& config() const { return config_; }
