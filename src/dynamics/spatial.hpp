@@ -3,6 +3,7 @@
 // 6x6 matrix is formed on the hot path.
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 
@@ -98,8 +99,9 @@ inline void sin_cos(double angle, double& s, double& c) {
 /// random angles up to 10^6 rad): the nearest multiple k of pi/2 is removed in three parts
 /// (Cody-Waite; each k * part exact for |k| < 2^26), Cephes' minimax polynomials on
 /// [-pi/4, pi/4], the quadrant from k mod 4. |angle| > 2^20 rad, inf and NaN go to sin_cos.
-/// ~6 ns against ~11 ns for glibc's sincos here; gravity_torques uses it (the libm calls were a
-/// third of that pass). The other passes keep sin_cos: their results stay bit for bit.
+/// ~6 ns against ~11 ns for glibc's sincos here; gravity_torques and crba use it (the libm calls
+/// were a third of the gravity pass). The other passes keep sin_cos:
+/// their results stay bit for bit.
 inline void sin_cos_poly(double angle, double& s, double& c) {
   if (!(std::abs(angle) <= 1048576.0)) {
     sin_cos(angle, s, c);
@@ -128,12 +130,17 @@ inline void sin_cos_poly(double angle, double& s, double& c) {
   }
   const double sin_r = r + r * z * ps;
   const double cos_r = 1.0 - 0.5 * z + z * z * pc;
-  // angle = k pi/2 + r: quadrant j = k mod 4 (two's complement: also for negative k).
-  const auto j = static_cast<std::int64_t>(k) & 3;
-  const double s1 = (j & 1) != 0 ? cos_r : sin_r;
-  const double c1 = (j & 1) != 0 ? sin_r : cos_r;
-  s = (j & 2) != 0 ? -s1 : s1;
-  c = ((j + 1) & 2) != 0 ? -c1 : c1;
+  // angle = k pi/2 + r: quadrant j = k mod 4 (two's complement: also for negative k). Selected
+  // with bit masks, not branches: the quadrant of arbitrary joint angles is unpredictable, and
+  // GCC compiled the ?: selections to jumps. Same values (negation = flipping the sign bit).
+  const auto j = static_cast<std::uint64_t>(static_cast<std::int64_t>(k));
+  const std::uint64_t swap = 0 - (j & 1);  // all ones in odd quadrants
+  const auto bs = std::bit_cast<std::uint64_t>(sin_r);
+  const auto bc = std::bit_cast<std::uint64_t>(cos_r);
+  const std::uint64_t s1 = (bs & ~swap) | (bc & swap);
+  const std::uint64_t c1 = (bc & ~swap) | (bs & swap);
+  s = std::bit_cast<double>(s1 ^ ((j & 2) << 62));
+  c = std::bit_cast<double>(c1 ^ (((j + 1) & 2) << 62));
 }
 
 /// Rotation by the angle of sine s and cosine c about the unit `axis` (Rodrigues).
