@@ -56,7 +56,8 @@ struct SimulatedLog {
 inline std::vector<Sample> simulate_free_motion(
     const Model& model, const sim::SinusoidalTrajectory& trajectory, const TrueFriction& friction,
     double duration, const Vector6& sensor_bias, double tau_noise, std::uint64_t seed,
-    std::vector<sim::ForceProfile> forces = {}, const Pose& sensor_pose = Pose()) {
+    std::vector<sim::ForceProfile> forces = {}, const Pose& sensor_pose = Pose(),
+    double tau_noise_per_speed = 0.0) {
   const double omega = 10.0;
   sim::PidGains gains;
   gains.kp = VectorX::Constant(7, 3 * omega * omega);
