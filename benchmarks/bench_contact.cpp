@@ -163,6 +163,18 @@ void register_contact_benchmarks() {
           run_update(state, arm.model, arm.geometry, options_for(c, link6), link6);
         });
   }
+  // Thresholds that follow |q̇| (a calibration's detection.tau_per_speed): the detector's extra
+  // per-sample work, against the constant thresholds above in the same binary. b is small so
+  // that the contact stays declared and every timed sample takes the full path.
+  for (const Config& c : {kTableI[0], kTableI[4]}) {
+    benchmark::RegisterBenchmark(
+        (std::string("BM_FullUpdate_Ours/") + c.name + "/capsules/speed_thresholds").c_str(),
+        [&arm, &link6, c](benchmark::State& state) {
+          EstimatorOptions o = options_for(c, link6);
+          o.detection.tau_per_speed = VectorX::Constant(1, 0.01);
+          run_update(state, arm.model, arm.geometry, o, link6);
+        });
+  }
   if (const MeshArm* panda = panda_arm(); panda != nullptr) {
     const Trajectory& tr = *panda_trajectory();
     for (const Config& c : {kTableI[0], kTableI[4]}) {

@@ -22,6 +22,8 @@ struct CalibrateOptions {
   std::string sign = "tanh";
   double smoothing_velocity = 0.0;
   double false_alarms_per_hour = 1.0;
+  std::string thresholds = "auto";
+  bool payload = false;
   std::vector<std::filesystem::path> package_path;
 };
 
@@ -42,21 +44,43 @@ void print_report(const Calibration& c, const HoldoutReport* h) {
     std::cout << "  " << i + 1 << "      " << fmt(c.friction.viscous[k]) << "  "
               << fmt(c.friction.coulomb[k]) << "  " << fmt(c.friction.offset[k]) << "  "
               << fmt(c.friction.smoothing(k)) << "  " << fmt(j.rms_before) << " -> "
-              << fmt(j.rms_after) << "  " << fmt(j.variance_explained) << "  " << fmt(j.threshold)
-              << (j.threshold_from_max ? " (largest residual)" : " (gaussian)") << "\n";
+              << fmt(j.rms_after) << "  " << fmt(j.variance_explained) << "  " << fmt(j.threshold);
+    if (j.speed_dependent)
+      std::cout << " + " << fmt(j.threshold_per_speed) << " |dq| (constant would be "
+                << fmt(j.threshold_constant) << ")";
+    std::cout << (j.threshold_from_max ? " (largest residual)" : " (gaussian)") << "\n";
   }
   if (c.sensor_type != SensorType::kNone) {
     std::cout << "  sensor bias [f; n] (S): " << fmt(Vector3(c.sensor_bias_S.head<3>())) << " N, "
               << fmt(Vector3(c.sensor_bias_S.tail<3>())) << " N m; F_min " << fmt(c.force_threshold)
               << " N\n";
   }
+  if (c.payload.identified) {
+    std::cout << "  payload on link " << c.payload.body << ": " << fmt(c.payload.mass)
+              << " kg, CoM " << fmt(c.payload.com) << " m (link frame); sensor RMS per axis "
+              << fmt(Vector3(c.payload.rms_before.head<3>())) << " N "
+              << fmt(Vector3(c.payload.rms_before.tail<3>())) << " N m -> "
+              << fmt(Vector3(c.payload.rms_after.head<3>())) << " N "
+              << fmt(Vector3(c.payload.rms_after.tail<3>())) << " N m\n";
+  }
+  std::cout << "  model check: residual RMS per joint before calibration [";
+  for (Eigen::Index i = 0; i < c.model_check.joint_rms.size(); ++i)
+    std::cout << (i ? " " : "") << fmt(c.model_check.joint_rms[i]);
+  std::cout << "] N m";
+  if (c.sensor_type != SensorType::kNone)
+    std::cout << "; sensor error RMS " << fmt(Vector3(c.model_check.sensor_rms.head<3>())) << " N "
+              << fmt(Vector3(c.model_check.sensor_rms.tail<3>())) << " N m";
+  std::cout << "\n";
+  for (const ModelPattern& p : c.model_check.patterns) std::cout << "    " << p.message << "\n";
+  if (c.model_check.patterns.empty()) std::cout << "    no recognisable model error\n";
   for (const std::string& w : c.warnings)
     std::cerr << "extwrench calibrate: warning: " << w << "\n";
   if (h == nullptr) return;
   std::cout << "  holdout: " << h->samples << " samples (" << fmt(h->duration)
             << " s): " << h->false_alarms << " false-alarm samples ("
             << fmt(h->samples ? 100.0 * h->false_alarms / h->samples : 0.0) << " %), uncalibrated "
-            << h->uncalibrated_false_alarms << "\n"
+            << h->uncalibrated_false_alarms << ", calibrated with constant thresholds "
+            << h->constant_threshold_false_alarms << "\n"
             << "  joint  calibrated threshold | smallest quiet constant: uncalibrated  "
                "calibrated\n";
   for (Eigen::Index i = 0; i < h->calibrated_threshold.size(); ++i)
@@ -64,12 +88,12 @@ void print_report(const Calibration& c, const HoldoutReport* h) {
               << fmt(h->best_constant_threshold[i]) << "  " << fmt(h->calibrated_max_residual[i])
               << "\n";
   std::cout << "  link   smallest detectable force at " << fmt(h->lever)
-            << " m [N] (median): calibrated thresholds | smallest quiet constant: uncalibrated  "
-               "calibrated\n";
+            << " m [N] (median): calibrated thresholds (constant form) | smallest quiet "
+               "constant: uncalibrated  calibrated\n";
   for (std::size_t l = 1; l < h->min_force_calibrated.size(); ++l)
-    std::cout << "  " << l << "      " << fmt(h->min_force_calibrated[l]) << " | "
-              << fmt(h->min_force_constant[l]) << "  " << fmt(h->min_force_calibrated_quiet[l])
-              << "\n";
+    std::cout << "  " << l << "      " << fmt(h->min_force_calibrated[l]) << " ("
+              << fmt(h->min_force_calibrated_constant[l]) << ") | " << fmt(h->min_force_constant[l])
+              << "  " << fmt(h->min_force_calibrated_quiet[l]) << "\n";
 }
 
 void run_calibrate(const CalibrateOptions& opt) {
@@ -87,7 +111,18 @@ void run_calibrate(const CalibrateOptions& opt) {
   if (!(opt.false_alarms_per_hour > 0))
     throw UsageError("--false-alarms-per-hour: expected a value > 0");
   co.smoothing_velocity = opt.smoothing_velocity;
+  co.payload = opt.payload;
   co.false_alarms_per_hour = opt.false_alarms_per_hour;
+  if (opt.thresholds == "auto") {
+    co.thresholds = ThresholdModel::kAuto;
+  } else if (opt.thresholds == "constant") {
+    co.thresholds = ThresholdModel::kConstant;
+  } else if (opt.thresholds == "speed") {
+    co.thresholds = ThresholdModel::kSpeed;
+  } else {
+    throw UsageError("--thresholds: expected auto, constant or speed, got '" + opt.thresholds +
+                     "'");
+  }
   LoadOptions load;
   load.package_path = opt.package_path;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
@@ -149,6 +184,13 @@ void register_calibrate(CLI::App& app) {
   sub->add_option("--false-alarms-per-hour", opt->false_alarms_per_hour,
                   "False-alarm rate the thresholds are set for (default 1)")
       ->type_name("RATE");
+  sub->add_option("--thresholds", opt->thresholds,
+                  "Joint thresholds: constant (a), speed (a + b|dq| on every joint) or auto "
+                  "(a + b|dq| where it is lower on average over the motion; default)")
+      ->type_name("FORM");
+  sub->add_flag("--payload", opt->payload,
+                "Identify a payload (mass, CoM) on the last link from the base F/T sensor and add "
+                "it to the model (needs sensor.type: ft)");
   add_package_path_option(*sub, opt->package_path);
   sub->callback([opt]() { run_calibrate(*opt); });
 }

@@ -8,6 +8,8 @@
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "friction_fit.hpp"
+#include "model_check.hpp"
+#include "payload_fit.hpp"
 
 namespace extwrench {
 namespace {
@@ -20,6 +22,9 @@ constexpr double kSettleTimeConstants = 5.0;
 constexpr int kParametersPerJoint = 3;  // D, F_c, o
 constexpr double kWindowGap = 0.02;     // [s] flagged samples closer than this form one window
 constexpr double kMadToSigma = 1.4826;  // σ of a Gaussian from its median absolute deviation
+// ThresholdModel::kAuto takes a + b|q̇| when its mean over the motion is below this × the
+// constant threshold for the same rate.
+constexpr double kSpeedGain = 0.95;
 
 void check_samples(const std::vector<Sample>& samples, int n) {
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -169,6 +174,51 @@ void joint_threshold(const std::vector<double>& r, const std::vector<Sample>& sa
   j.threshold = std::max(std::max(gaussian, extrapolated), 1e-6);
 }
 
+// Thresholds that follow the speed: the spread of the residual as a line in |q̇|,
+// σ(v) = √(π/2) (e₀ + e₁ v) from the least-squares line through |r_k| against v_k = |q̇_k|
+// (E|r| = σ √(2/π) for a zero-mean Gaussian); then the residual normalised by it, z = r / σ(v),
+// gets the constant rule (joint_threshold) for the same rate, u, and τ_thr(v) = u σ(v).
+// e₀ is kept ≥ a quarter of the mean |r| (else a threshold near zero at rest).
+void speed_threshold(const std::vector<double>& r, const std::vector<double>& dq,
+                     const std::vector<Sample>& samples, const std::vector<char>& use, double rate,
+                     double margin, JointFitReport& j) {
+  double s1 = 0, sv = 0, svv = 0, se = 0, sve = 0;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    if (!use[k]) continue;
+    const double v = std::abs(dq[k]), e = std::abs(r[k]);
+    s1 += 1;
+    sv += v;
+    svv += v * v;
+    se += e;
+    sve += v * e;
+  }
+  const double mean_e = se / s1;
+  const double det = s1 * svv - sv * sv;
+  double e1 = det > 1e-12 * s1 * svv ? (s1 * sve - sv * se) / det : 0.0;
+  double e0 = (se - e1 * sv) / s1;
+  if (e1 <= 0.0) {
+    e1 = 0.0;
+    e0 = mean_e;
+  } else if (e0 < 0.25 * mean_e) {
+    e0 = 0.25 * mean_e;
+    e1 = svv > 0 ? std::max((sve - e0 * sv) / svv, 0.0) : 0.0;
+  }
+  const double c = std::sqrt(std::acos(-1.0) / 2.0);
+  j.noise_at_rest = c * e0;
+  j.noise_per_speed = c * e1;
+  std::vector<double> z(r.size(), 0.0);
+  for (std::size_t k = 0; k < r.size(); ++k)
+    z[k] = r[k] / std::max(j.noise_at_rest + j.noise_per_speed * std::abs(dq[k]), 1e-12);
+  JointFitReport zj;
+  joint_threshold(z, samples, use, rate, margin, zj);
+  j.threshold_at_rest = zj.threshold * j.noise_at_rest;
+  j.threshold_per_speed = zj.threshold * j.noise_per_speed;
+  double sum = 0.0;
+  for (std::size_t k = 0; k < r.size(); ++k)
+    if (use[k]) sum += j.threshold_at_rest + j.threshold_per_speed * std::abs(dq[k]);
+  j.mean_threshold_speed = sum / s1;
+}
+
 // Bias of the base sensor: the mean of reading − predicted no-contact reading (sensor frame)
 // with the calibrated friction; then F̂_ext's spread per world axis and F_min.
 void sensor_calibration(const Model& model, const EstimatorOptions& options,
@@ -181,6 +231,7 @@ void sensor_calibration(const Model& model, const EstimatorOptions& options,
   ContactEstimator est(model, GeometryModel{}, opt);
   Vector6 sum = Vector6::Zero();
   std::size_t count = 0;
+  std::vector<Vector6> errors, predictions;  // for the model check
   for (std::size_t pass = 0; pass < 2; ++pass) {
     if (!est.reset(samples.front()).ok()) throw Error("calibration: estimator reset failed");
     Vector3 s1 = Vector3::Zero(), s2 = Vector3::Zero();
@@ -194,6 +245,8 @@ void sensor_calibration(const Model& model, const EstimatorOptions& options,
         predicted_S.head<3>() = X_WS.rotation.transpose() * predicted_W.head<3>();
         predicted_S.tail<3>() = X_WS.rotation.transpose() * predicted_W.tail<3>();
         sum += samples[k].reading_S - predicted_S;
+        errors.push_back(samples[k].reading_S - predicted_S);
+        predictions.push_back(predicted_S);
         ++count;
       } else {
         const Vector3& f = est.result().force_W;
@@ -206,6 +259,8 @@ void sensor_calibration(const Model& model, const EstimatorOptions& options,
     }
     if (count == 0) throw Error("calibration: no usable base-sensor sample");
     if (pass == 0) {
+      calibration_detail::check_sensor(
+          errors, predictions, opt.sensor.type == SensorType::kForceTorque, cal.model_check);
       cal.sensor_bias_S = sum / static_cast<double>(count);
       if (opt.sensor.type == SensorType::kForce) cal.sensor_bias_S.tail<3>().setZero();
       est.set_sensor_bias(cal.sensor_bias_S);
@@ -242,6 +297,7 @@ void exclude_windows(const std::vector<SuspectWindow>& windows, const std::vecto
 /// The fitted friction and offsets into `cal`, and per joint the residual's threshold for the
 /// false-alarm rate, before (r0, the model's own friction) and after the fit.
 void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
+                             const std::vector<JointSeries>& series,
                              const std::vector<JointSeries>& before,
                              const std::vector<Sample>& samples, const std::vector<char>& use,
                              const CalibrationOptions& o, Calibration& cal) {
@@ -252,6 +308,7 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
   cal.friction.joint_smoothing = VectorX::Zero(n);
   if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift = VectorX::Zero(n);
   cal.tau_threshold = VectorX::Zero(n);
+  cal.tau_per_speed = VectorX::Zero(n);
   const double rate = o.false_alarms_per_hour / 3600.0 / n;
   for (int i = 0; i < n; ++i) {
     const JointFrictionFit& f = fits[static_cast<std::size_t>(i)];
@@ -270,6 +327,17 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
     joint_threshold(f.residual, samples, use, rate, o.threshold_margin, j);
     j.variance_explained =
         b.noise_std > 0 ? 1.0 - (j.noise_std * j.noise_std) / (b.noise_std * b.noise_std) : 0.0;
+    j.threshold_constant = j.threshold;
+    speed_threshold(f.residual, series[static_cast<std::size_t>(i)].dq, samples, use, rate,
+                    o.threshold_margin, j);
+    j.speed_dependent = j.threshold_per_speed > 0.0 &&
+                        (o.thresholds == ThresholdModel::kSpeed ||
+                         (o.thresholds == ThresholdModel::kAuto &&
+                          j.mean_threshold_speed < kSpeedGain * j.threshold_constant));
+    if (j.speed_dependent) {
+      j.threshold = j.threshold_at_rest;
+      cal.tau_per_speed[i] = j.threshold_per_speed;
+    }
     cal.tau_threshold[i] = j.threshold;
     cal.joints.push_back(j);
   }
@@ -301,12 +369,40 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
     auto& body = m.bodies[static_cast<std::size_t>(options.payload->body)];
     body.inertia = body.inertia + options.payload->inertia;
   }
+  Calibration cal;
+  if (o.payload) {
+    if (options.sensor.type != SensorType::kForceTorque) {
+      throw Error(
+          "calibration: payload identification needs a base force/torque sensor (sensor.type: "
+          "ft; the moments carry the centre of mass), this configuration has sensor.type: " +
+          std::string(to_string(options.sensor.type)));
+    }
+    if (options.payload && options.payload->body != n) {
+      throw Error("calibration: the configuration has a payload on body " +
+                  std::to_string(options.payload->body) +
+                  "; payload identification is for the last link (" + std::to_string(n) + ")");
+    }
+    const calibration_detail::PayloadFit pf =
+        calibration_detail::fit_payload(m, options.sensor.X_WS, n, samples, use);
+    cal.payload.identified = true;
+    cal.payload.body = n;
+    cal.payload.mass = pf.mass;
+    cal.payload.com = pf.first_moment / pf.mass;
+    cal.payload.rms_before = pf.rms_before;
+    cal.payload.rms_after = pf.rms_after;
+    cal.payload.condition = pf.condition;
+    cal.payload.samples = pf.samples;
+    Inertia identified;
+    identified.mass = pf.mass;
+    identified.com = cal.payload.com;
+    auto& body = m.bodies[static_cast<std::size_t>(n)];
+    body.inertia = body.inertia + identified;
+  }
   std::vector<JointSeries> series, before;
   run_observer(m, gains, JointFriction::none(n), samples, series, false);
   run_observer(m, gains, options.friction ? *options.friction : JointFriction::from_model(model),
                samples, before, true);
 
-  Calibration cal;
   cal.observer_gain = gains;
   cal.sensor_type = options.sensor.type;
   cal.false_alarms_per_hour = o.false_alarms_per_hour;
@@ -347,15 +443,50 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
         list);
   }
   cal.samples_used = static_cast<int>(std::count(use.begin(), use.end(), 1));
-  friction_and_thresholds(fits, before, samples, use, o, cal);
+  friction_and_thresholds(fits, series, before, samples, use, o, cal);
+  {  // Model check: g(q) along the log for the gravity pattern.
+    Data data(m);
+    std::vector<std::vector<double>> gravity(static_cast<std::size_t>(n),
+                                             std::vector<double>(samples.size(), 0.0));
+    for (std::size_t k = 0; k < samples.size(); ++k) {
+      const VectorX& g = gravity_torques(m, data, samples[k].q);
+      for (int i = 0; i < n; ++i) gravity[static_cast<std::size_t>(i)][k] = g[i];
+    }
+    calibration_detail::check_joints(series, before, fits, gravity, use, cal.model_check);
+  }
   if (options.sensor.type != SensorType::kNone)
     sensor_calibration(model, options, samples, use, o, cal);
+  // A base moment linear in the configuration is a sensor pose error only when the joints do
+  // not follow g(q) too: a mass error moves both, a sensor pose the sensor alone.
+  auto& patterns = cal.model_check.patterns;
+  const bool gravity = std::any_of(patterns.begin(), patterns.end(),
+                                   [](const ModelPattern& p) { return p.kind == "gravity"; });
+  if (gravity) {
+    patterns.erase(std::remove_if(patterns.begin(), patterns.end(),
+                                  [](const ModelPattern& p) { return p.kind == "sensor_pose"; }),
+                   patterns.end());
+  }
   return cal;
 }
 
 EstimatorOptions apply_calibration(EstimatorOptions options, const Calibration& calibration) {
+  if (calibration.payload.identified) {
+    Inertia identified;
+    identified.mass = calibration.payload.mass;
+    identified.com = calibration.payload.com;
+    if (!options.payload) {
+      options.payload = PayloadOptions{calibration.payload.body, identified};
+    } else if (options.payload->body == calibration.payload.body) {
+      options.payload->inertia = options.payload->inertia + identified;
+    } else {
+      throw Error("calibration: the identified payload is on body " +
+                  std::to_string(calibration.payload.body) + ", the configured one on body " +
+                  std::to_string(options.payload->body));
+    }
+  }
   options.friction = calibration.friction;
   options.detection.tau_min = calibration.tau_threshold;
+  options.detection.tau_per_speed = calibration.tau_per_speed;
   if (calibration.sensor_type != SensorType::kNone && calibration.force_threshold > 0) {
     options.detection.f_min = calibration.force_threshold;
     options.sensor.bias_S = calibration.sensor_bias_S;

@@ -45,21 +45,38 @@ HoldoutReport validate_holdout(const Model& model, const EstimatorOptions& optio
   if (first >= samples.size()) throw Error("holdout: no sample after the fit window");
   const int n = model.nq();
   ContactEstimator plain(model, GeometryModel{}, options);
-  ContactEstimator calibrated(model, GeometryModel{}, apply_calibration(options, calibration));
+  const EstimatorOptions calibrated_options = apply_calibration(options, calibration);
+  ContactEstimator calibrated(model, GeometryModel{}, calibrated_options);
   HoldoutReport rep;
   rep.lever = lever;
   rep.calibrated_threshold = calibration.tau_threshold;
+  rep.calibrated_per_speed =
+      calibration.tau_per_speed.size() == n ? calibration.tau_per_speed : VectorX::Zero(n);
+  rep.calibrated_constant_threshold = calibration.tau_threshold;
+  for (int i = 0; i < n && static_cast<std::size_t>(i) < calibration.joints.size(); ++i) {
+    const JointFitReport& j = calibration.joints[static_cast<std::size_t>(i)];
+    if (j.speed_dependent) rep.calibrated_constant_threshold[i] = j.threshold_constant;
+  }
+  EstimatorOptions constant_options = calibrated_options;
+  constant_options.detection.tau_min = rep.calibrated_constant_threshold;
+  constant_options.detection.tau_per_speed.resize(0);
+  ContactEstimator constant_est(model, GeometryModel{}, constant_options);
+  const bool speed = (rep.calibrated_per_speed.array() > 0.0).any();
   rep.best_constant_threshold = VectorX::Zero(n);
   rep.calibrated_max_residual = VectorX::Zero(n);
-  if (!plain.reset(samples.front()).ok() || !calibrated.reset(samples.front()).ok())
+  if (!plain.reset(samples.front()).ok() || !calibrated.reset(samples.front()).ok() ||
+      (speed && !constant_est.reset(samples.front()).ok()))
     throw Error("holdout: estimator reset failed on the first sample");
   for (std::size_t k = 1; k < samples.size(); ++k) {
     const bool ok_plain = plain.update(samples[k]).ok();
     const bool ok_cal = calibrated.update(samples[k]).ok();
-    if (k < first || !ok_plain || !ok_cal) continue;
+    const bool ok_const = !speed || constant_est.update(samples[k]).ok();
+    if (k < first || !ok_plain || !ok_cal || !ok_const) continue;
     ++rep.samples;
     if (plain.result().contact) ++rep.uncalibrated_false_alarms;
     if (calibrated.result().contact) ++rep.false_alarms;
+    if (speed ? constant_est.result().contact : calibrated.result().contact)
+      ++rep.constant_threshold_false_alarms;
     if (calibrated.detector().result().raw) ++rep.raw_alarms;
     rep.best_constant_threshold =
         rep.best_constant_threshold.cwiseMax(plain.result().residual.cwiseAbs());
@@ -72,14 +89,19 @@ HoldoutReport validate_holdout(const Model& model, const EstimatorOptions& optio
   const VectorX quiet = rep.calibrated_max_residual.cwiseMax(1e-9);
   Data data(model);
   std::vector<std::vector<double>> cal_f(static_cast<std::size_t>(n) + 1),
-      const_f(static_cast<std::size_t>(n) + 1), quiet_f(static_cast<std::size_t>(n) + 1);
+      const_f(static_cast<std::size_t>(n) + 1), quiet_f(static_cast<std::size_t>(n) + 1),
+      cal_const_f(static_cast<std::size_t>(n) + 1);
+  VectorX threshold(n);
   for (std::size_t k = first; k < samples.size(); ++k) {
     forward_kinematics(model, data, samples[k].q);
+    threshold =
+        rep.calibrated_threshold + rep.calibrated_per_speed.cwiseProduct(samples[k].dq.cwiseAbs());
     for (int l = 1; l <= n; ++l) {
       const Vector3 p_W = lever_point(model, data, l, lever);
       const auto li = static_cast<std::size_t>(l);
-      cal_f[li].push_back(
-          smallest_detectable_force(model, data, l, p_W, calibration.tau_threshold));
+      cal_f[li].push_back(smallest_detectable_force(model, data, l, p_W, threshold));
+      cal_const_f[li].push_back(
+          smallest_detectable_force(model, data, l, p_W, rep.calibrated_constant_threshold));
       const_f[li].push_back(smallest_detectable_force(model, data, l, p_W, constant));
       quiet_f[li].push_back(smallest_detectable_force(model, data, l, p_W, quiet));
     }
@@ -87,8 +109,10 @@ HoldoutReport validate_holdout(const Model& model, const EstimatorOptions& optio
   rep.min_force_calibrated.assign(static_cast<std::size_t>(n) + 1, 0.0);
   rep.min_force_constant.assign(static_cast<std::size_t>(n) + 1, 0.0);
   rep.min_force_calibrated_quiet.assign(static_cast<std::size_t>(n) + 1, 0.0);
+  rep.min_force_calibrated_constant.assign(static_cast<std::size_t>(n) + 1, 0.0);
   for (int l = 1; l <= n; ++l) {
     const auto li = static_cast<std::size_t>(l);
+    rep.min_force_calibrated_constant[li] = median(cal_const_f[li]);
     rep.min_force_calibrated[li] = median(cal_f[li]);
     rep.min_force_constant[li] = median(const_f[li]);
     rep.min_force_calibrated_quiet[li] = median(quiet_f[li]);

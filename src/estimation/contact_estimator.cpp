@@ -174,7 +174,7 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
   ground_wrench(dq);                              // 4
   dq_prev_ = dq;
   t_ = t;
-  estimate(t, reading_S);  // 5–9
+  estimate(t, dq, reading_S);  // 5–9
   return out_.status;
 }
 
@@ -293,7 +293,7 @@ Status ContactEstimator::update_with(double t, const Eigen::Ref<const VectorX>& 
   initialized_ = true;
   t_ = t;
   out_.status = Status::success();
-  estimate(t, reading_S);
+  estimate(t, dq, reading_S);
   return out_.status;
 }
 
@@ -307,8 +307,9 @@ void ContactEstimator::begin_output(double t) noexcept {
   out_.residual = tau_ext_;
 }
 
-// Stages 5–9 on τ̂_ext and data_ (poses, ground wrench). Out: out_.
-void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
+// Stages 5–9 on τ̂_ext, q̇ (thresholds that follow it) and data_ (poses, ground wrench). Out: out_.
+void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
+                                const Vector6& reading_S) noexcept {
   begin_output(t);
   std::uint32_t flags = 0;
   const bool has_sensor = options_.sensor.type != SensorType::kNone && out_.status.ok();
@@ -321,6 +322,7 @@ void ContactEstimator::estimate(double t, const Vector6& reading_S) noexcept {
   const double release_force = has_sensor && !base.taring && release_link_ >= 0
                                    ? sensor_release_force(base)
                                    : ContactDetector::kNoReleaseForce;
+  detector_.set_motion(dq);  // thresholds that follow |q̇| (no-op when constant)
   const DetectionResult& det = detector_.update(t, tau_ext_, base_force, release_force);
   out_.contact = det.contact;
   flags |= detection_flags(det);

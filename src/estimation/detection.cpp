@@ -24,6 +24,17 @@ void validate(const DetectionOptions& options, int n) {
       throw Error("detection.tau_min[" + std::to_string(i) + "]: expected a finite value > 0");
     }
   }
+  const VectorX& b = options.tau_per_speed;
+  if (b.size() != 0 && b.size() != 1 && b.size() != n) {
+    throw Error("detection.tau_per_speed: expected 1 or " + std::to_string(n) + " values, got " +
+                std::to_string(b.size()));
+  }
+  for (Eigen::Index i = 0; i < b.size(); ++i) {
+    if (!std::isfinite(b[i]) || b[i] < 0.0) {
+      throw Error("detection.tau_per_speed[" + std::to_string(i) +
+                  "]: expected a finite value >= 0 [N m s/rad]");
+    }
+  }
   if (!std::isfinite(options.f_min) || !(options.f_min > 0.0)) {
     throw Error("detection.f_min: expected a finite value > 0");
   }
@@ -40,7 +51,16 @@ ContactDetector::ContactDetector(const DetectionOptions& options, int n, double 
   validate(options, n);
   const VectorX& t = options.tau_min;
   tau_min_ = t.size() == 1 ? VectorX::Constant(n, t[0]) : t;
+  const VectorX& b = options.tau_per_speed;
+  tau_speed_ = b.size() == 0 ? VectorX::Zero(n) : b.size() == 1 ? VectorX::Constant(n, b[0]) : b;
+  speed_dependent_ = (tau_speed_.array() > 0.0).any();
+  threshold_ = tau_min_;
   joint_over_.setConstant(n, false);
+}
+
+void ContactDetector::set_motion(const Eigen::Ref<const VectorX>& dq) noexcept {
+  if (!speed_dependent_) return;
+  threshold_.array() = tau_min_.array() + tau_speed_.array() * dq.array().abs();
 }
 
 void ContactDetector::reset() noexcept {
@@ -53,6 +73,7 @@ void ContactDetector::reset() noexcept {
   release_time_ = 0.0;
   release_level_ = 0.0;
   sensor_release_disproved_ = false;
+  threshold_ = tau_min_;
   result_ = DetectionResult{};
 }
 
@@ -61,9 +82,9 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
                                                double release_force_norm) noexcept {
   const double ratio = options_.release_ratio;
   int link = -1;
-  for (Eigen::Index i = 0; i < tau_min_.size(); ++i) {
-    // Hysteresis: once over, a joint stays over until it falls below ratio × τ_min.
-    const double level = joint_over_[i] ? ratio * tau_min_[i] : tau_min_[i];
+  for (Eigen::Index i = 0; i < threshold_.size(); ++i) {
+    // Hysteresis: once over, a joint stays over until it falls below ratio × τ_thr.
+    const double level = joint_over_[i] ? ratio * threshold_[i] : threshold_[i];
     joint_over_[i] = std::abs(tau_ext[i]) > level;
     if (joint_over_[i]) link = static_cast<int>(i) + 1;  // largest joint index over threshold
   }
@@ -127,8 +148,8 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
 double ContactDetector::level(const Eigen::Ref<const VectorX>& tau_ext,
                               double base_force_norm) const noexcept {
   double out = std::isfinite(base_force_norm) ? base_force_norm / options_.f_min : 0.0;
-  for (Eigen::Index i = 0; i < tau_min_.size(); ++i)
-    out = std::max(out, std::abs(tau_ext[i]) / tau_min_[i]);
+  for (Eigen::Index i = 0; i < threshold_.size(); ++i)
+    out = std::max(out, std::abs(tau_ext[i]) / threshold_[i]);
   return out;
 }
 

@@ -88,7 +88,13 @@ std::string joint_table(const Calibration& c) {
       << ", max_after: " << j.max_after << ", variance_explained: " << j.variance_explained
       << ", noise_std: " << j.noise_std << ", crossing_rate: " << j.crossing_rate
       << ", condition: " << j.condition << ", threshold: " << j.threshold
-      << ", threshold_rule: " << (j.threshold_from_max ? "largest_residual" : "gaussian") << "}\n";
+      << ", threshold_rule: " << (j.threshold_from_max ? "largest_residual" : "gaussian")
+      << ", noise_at_rest: " << j.noise_at_rest << ", noise_per_speed: " << j.noise_per_speed
+      << ", threshold_constant: " << j.threshold_constant
+      << ", threshold_at_rest: " << j.threshold_at_rest
+      << ", threshold_per_speed: " << j.threshold_per_speed
+      << ", mean_threshold_speed: " << j.mean_threshold_speed
+      << ", threshold_form: " << (j.speed_dependent ? "speed" : "constant") << "}\n";
   }
   return y.str();
 }
@@ -101,7 +107,10 @@ std::string holdout_yaml(const HoldoutReport& h) {
     << "\n  false_alarm_samples: " << h.false_alarms << "\n  false_alarm_percent: " << share
     << "\n  raw_alarm_samples: " << h.raw_alarms
     << "\n  uncalibrated_false_alarm_samples: " << h.uncalibrated_false_alarms
+    << "\n  constant_threshold_false_alarm_samples: " << h.constant_threshold_false_alarms
     << "\n  calibrated_threshold: " << yaml_list(h.calibrated_threshold)
+    << "\n  calibrated_per_speed: " << yaml_list(h.calibrated_per_speed)
+    << "\n  calibrated_constant_threshold: " << yaml_list(h.calibrated_constant_threshold)
     << "\n  best_constant_threshold_uncalibrated: " << yaml_list(h.best_constant_threshold)
     << "\n  calibrated_max_residual: " << yaml_list(h.calibrated_max_residual)
     << "\n  lever: " << h.lever << "\n  min_force_calibrated: [";
@@ -110,6 +119,9 @@ std::string holdout_yaml(const HoldoutReport& h) {
   y << "]\n  min_force_best_constant: [";
   for (std::size_t l = 1; l < h.min_force_constant.size(); ++l)
     y << (l > 1 ? ", " : "") << h.min_force_constant[l];
+  y << "]\n  min_force_calibrated_constant_threshold: [";
+  for (std::size_t l = 1; l < h.min_force_calibrated_constant.size(); ++l)
+    y << (l > 1 ? ", " : "") << h.min_force_calibrated_constant[l];
   y << "]\n  min_force_calibrated_best_constant: [";
   for (std::size_t l = 1; l < h.min_force_calibrated_quiet.size(); ++l)
     y << (l > 1 ? ", " : "") << h.min_force_calibrated_quiet[l];
@@ -138,6 +150,8 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
   y << "observer: {gain: " << yaml_list(c.observer_gain) << "}\n";
   y << "friction: " << io_detail::friction_mapping_yaml(c.friction) << "\n";
   y << "detection: {tau_min: " << yaml_list(c.tau_threshold);
+  if (c.tau_per_speed.size() > 0 && (c.tau_per_speed.array() > 0.0).any())
+    y << ", tau_per_speed: " << yaml_list(c.tau_per_speed);
   if (c.sensor_type != SensorType::kNone) y << ", f_min: " << c.force_threshold;
   y << "}\n";
   y << "sensor: {type: " << to_string(c.sensor_type);
@@ -148,6 +162,28 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
       << c.force_noise_W.z() << ']';
   }
   y << "}\n";
+  if (c.payload.identified) {
+    const PayloadReport& p = c.payload;
+    y << "payload: {body: " << p.body << ", mass: " << p.mass << ", com: [" << p.com.x() << ", "
+      << p.com.y() << ", " << p.com.z() << "], rms_before: " << yaml_list(VectorX(p.rms_before))
+      << ", rms_after: " << yaml_list(VectorX(p.rms_after)) << ", condition: " << p.condition
+      << ", samples: " << p.samples << "}\n";
+  }
+  if (c.model_check.joint_rms.size() > 0) {
+    const ModelCheck& m = c.model_check;
+    y << "model_check:\n  joint_rms: " << yaml_list(m.joint_rms) << '\n';
+    if (c.sensor_type != SensorType::kNone) {
+      y << "  sensor_rms: " << yaml_list(VectorX(m.sensor_rms))
+        << "\n  sensor_mean: " << yaml_list(VectorX(m.sensor_mean)) << '\n';
+    }
+    y << "  patterns: [";
+    for (std::size_t i = 0; i < m.patterns.size(); ++i) {
+      const ModelPattern& p = m.patterns[i];
+      y << (i ? ",\n    " : "\n    ") << "{kind: " << p.kind << ", joint: " << p.joint
+        << ", share: " << p.share << ", message: " << quoted(p.message) << '}';
+    }
+    y << "]\n";
+  }
   double worst = 0.0;
   for (const JointFitReport& j : c.joints) worst = std::max(worst, j.condition);
   y << "fit:\n  samples: " << c.samples_used << "\n  condition: " << worst << "\n  joints:\n"
@@ -172,8 +208,8 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
     const io_detail::YamlReader rd(path.string());
     if (!root.IsDefined() || !root.IsMap()) rd.fail(root, "(top level)", "empty calibration");
     rd.only_keys(root, "",
-                 {"calibration", "observer", "friction", "detection", "sensor", "fit", "holdout",
-                  "warnings"});
+                 {"calibration", "observer", "friction", "detection", "sensor", "payload",
+                  "model_check", "fit", "holdout", "warnings"});
     Calibration c;
     c.source = path.string();
     const io_detail::Range positive = io_detail::positive();
@@ -183,9 +219,14 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
     c.friction =
         io_detail::read_friction_mapping(rd, rd.required(root, "", "friction"), n, "friction");
     const YAML::Node det = rd.required(root, "", "detection");
-    rd.only_keys(det, "detection", {"tau_min", "f_min"});
+    rd.only_keys(det, "detection", {"tau_min", "tau_per_speed", "f_min"});
     c.tau_threshold =
         rd.vector(rd.required(det, "detection", "tau_min"), "detection.tau_min", n, &positive);
+    // Thresholds that follow |q̇| (absent in files written before them: constant).
+    const io_detail::Range per_speed = io_detail::non_negative();
+    c.tau_per_speed = det["tau_per_speed"] ? rd.vector(det["tau_per_speed"],
+                                                       "detection.tau_per_speed", n, &per_speed)
+                                           : VectorX::Zero(n);
     const YAML::Node sensor = rd.required(root, "", "sensor");
     rd.only_keys(sensor, "sensor", {"type", "bias", "force_noise_W"});
     c.sensor_type = rd.sensor_type(rd.required(sensor, "sensor", "type"), "sensor.type");
@@ -195,6 +236,18 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
       rd.set_number_in(det, "detection", "f_min", {0, 1e12, true, "> 0 [N]"}, c.force_threshold);
       if (!(c.force_threshold > 0))
         rd.fail(det, "detection.f_min", "missing (required with a sensor)");
+    }
+    if (const YAML::Node p = root["payload"]) {
+      rd.only_keys(p, "payload",
+                   {"body", "mass", "com", "rms_before", "rms_after", "condition", "samples"});
+      c.payload.identified = true;
+      c.payload.body =
+          static_cast<int>(rd.number_in(rd.required(p, "payload", "body"), "payload.body",
+                                        {1, static_cast<double>(n), false, "a link index 1..n"}));
+      if (c.payload.body != n) rd.fail(p["body"], "payload.body", "expected the last link");
+      c.payload.mass = rd.number_in(rd.required(p, "payload", "mass"), "payload.mass",
+                                    {0, 1e9, true, "> 0 [kg]"});
+      c.payload.com = rd.vector3(rd.required(p, "payload", "com"), "payload.com");
     }
     return c;
   });

@@ -62,9 +62,13 @@ void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorO
 }
 
 void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionOptions& o) {
-  rd.only_keys(d, "detection", {"tau_min", "f_min", "release_ratio", "min_duration"});
+  rd.only_keys(d, "detection",
+               {"tau_min", "tau_per_speed", "f_min", "release_ratio", "min_duration"});
   const Range tau_min = positive();
   if (d["tau_min"]) o.tau_min = rd.vector(d["tau_min"], "detection.tau_min", n, &tau_min);
+  const Range per_speed = io_detail::non_negative(">= 0 [N m s/rad]");
+  if (d["tau_per_speed"])
+    o.tau_per_speed = rd.vector(d["tau_per_speed"], "detection.tau_per_speed", n, &per_speed);
   rd.set_number_in(d, "detection", "f_min", {0, 1e12, true, "> 0 [N]"}, o.f_min);
   rd.set_number_in(d, "detection", "release_ratio", {0, 1, true, "in (0, 1]"}, o.release_ratio);
   rd.set_number_in(d, "detection", "min_duration", {0, 1e6, false, ">= 0 [s]"}, o.min_duration);
@@ -104,7 +108,8 @@ void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOp
 
 // `calibration: CALIB.yaml` (relative to the configuration): friction, thresholds and sensor
 // bias from `extwrench calibrate`. Keys the configuration sets itself (friction,
-// detection.tau_min, detection.f_min, sensor.tare) win over the calibration's.
+// detection.tau_min, detection.tau_per_speed, detection.f_min, sensor.tare) win over the
+// calibration's; a configuration setting tau_min alone gets constant thresholds.
 void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::path& source, int n,
                       EstimatorOptions& o) {
   const YAML::Node node = root["calibration"];
@@ -133,6 +138,24 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
   const YAML::Node det = root["detection"];
   if (!root["friction"]) o.friction = cal.friction;
   if (!(det && det["tau_min"])) o.detection.tau_min = cal.tau_threshold;
+  // The speed term belongs to the calibration's τ_min: taken with it, unless set here.
+  if (!(det && (det["tau_min"] || det["tau_per_speed"])))
+    o.detection.tau_per_speed = cal.tau_per_speed;
+  if (cal.payload.identified) {  // added to a configured payload on the same link
+    Inertia identified;
+    identified.mass = cal.payload.mass;
+    identified.com = cal.payload.com;
+    if (!o.payload) {
+      o.payload = PayloadOptions{cal.payload.body, identified};
+    } else if (o.payload->body == cal.payload.body) {
+      o.payload->inertia = o.payload->inertia + identified;
+    } else {
+      rd.fail(node, "calibration",
+              "'" + path.string() +
+                  "' identified a payload on the last link, this "
+                  "configuration has one on another link");
+    }
+  }
   if (cal.sensor_type != SensorType::kNone) {
     if (!(det && det["f_min"])) o.detection.f_min = cal.force_threshold;
     if (o.sensor.tare_samples == 0) o.sensor.bias_S = cal.sensor_bias_S;
@@ -332,8 +355,10 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
     y << "  point: " << list3(o.contact.point_L) << '\n';
   }
   y << "observer:\n  gain: " << io_detail::yaml_list(o.observer_gain) << '\n';
-  y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min)
-    << "\n  f_min: " << o.detection.f_min << "\n  release_ratio: " << o.detection.release_ratio
+  y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min);
+  if ((o.detection.tau_per_speed.array() > 0.0).any())
+    y << "\n  tau_per_speed: " << io_detail::yaml_list(o.detection.tau_per_speed);
+  y << "\n  f_min: " << o.detection.f_min << "\n  release_ratio: " << o.detection.release_ratio
     << "\n  min_duration: " << o.detection.min_duration << '\n';
   y << "acceleration: {route: " << to_string(o.acceleration)
     << ", cutoff: " << o.differentiation_cutoff << "}\n";

@@ -49,13 +49,15 @@ struct SimulatedLog {
 };
 
 /// `duration` s of `trajectory` on the paper arm with a base F/T sensor (bias, noise), joint
-/// torque noise `tau_noise` [N m] and the true friction; `forces` pushes the robot.
-inline std::vector<Sample> simulate_free_motion(const Model& model,
-                                                const sim::SinusoidalTrajectory& trajectory,
-                                                const TrueFriction& friction, double duration,
-                                                const Vector6& sensor_bias, double tau_noise,
-                                                std::uint64_t seed,
-                                                std::vector<sim::ForceProfile> forces = {}) {
+/// torque noise `tau_noise` [N m] and the true friction; `forces` pushes the robot;
+/// `sensor_pose`: the sensor's true pose (the estimator may assume another);
+/// `tau_noise_per_speed` [N m s/rad]: torque noise that grows with the speed, σ = tau_noise +
+/// tau_noise_per_speed |q̇| (the Panda's measured τ and q̇ carry such noise).
+inline std::vector<Sample> simulate_free_motion(
+    const Model& model, const sim::SinusoidalTrajectory& trajectory, const TrueFriction& friction,
+    double duration, const Vector6& sensor_bias, double tau_noise, std::uint64_t seed,
+    std::vector<sim::ForceProfile> forces = {}, const Pose& sensor_pose = Pose(),
+    double tau_noise_per_speed = 0.0) {
   const double omega = 10.0;
   sim::PidGains gains;
   gains.kp = VectorX::Constant(7, 3 * omega * omega);
@@ -66,7 +68,7 @@ inline std::vector<Sample> simulate_free_motion(const Model& model,
   config.duration = duration;
   config.sample_time = 1e-3;
   config.sensor.type = SensorType::kForceTorque;
-  config.sensor.X_WS = Pose();
+  config.sensor.X_WS = sensor_pose;
   config.sensor.bias_S = sensor_bias;
   config.sensor.force_noise_S = Vector3::Constant(0.2);
   config.sensor.moment_noise_S = Vector3::Constant(0.02);
@@ -82,7 +84,7 @@ inline std::vector<Sample> simulate_free_motion(const Model& model,
       const double dq = s.dq[i];
       s.tau[i] += friction.viscous[i] * dq +
                   friction.coulomb[i] * std::tanh(dq / friction.smoothing[i]) + friction.offset[i] +
-                  tau_noise * rng.normal();
+                  (tau_noise + tau_noise_per_speed * std::abs(dq)) * rng.normal();
     }
     samples.push_back(s);
   }

@@ -232,12 +232,85 @@ TEST(CalibratedEstimator, UpdateAllocatesNothing) {
   const auto log =
       test::simulate_free_motion(model, test::free_motion(0.0, 1.0), test::paper_arm_friction(),
                                  3.0, Vector6::Zero(), 0.02, 3);
-  const Calibration cal = calibrate(model, options, log);
-  ContactEstimator est(model, GeometryModel{}, apply_calibration(options, cal));
-  ASSERT_TRUE(est.reset(log.front()).ok());
-  const test::AllocationCounter counter;
-  for (std::size_t k = 1; k < log.size(); ++k) (void)est.update(log[k]);
-  EXPECT_EQ(counter.count(), 0u);
+  CalibrationOptions speed;
+  speed.thresholds = ThresholdModel::kSpeed;  // thresholds a + b|q̇| on every joint
+  for (const CalibrationOptions& co : {CalibrationOptions{}, speed}) {
+    const Calibration cal = calibrate(model, options, log, co);
+    ContactEstimator est(model, GeometryModel{}, apply_calibration(options, cal));
+    ASSERT_TRUE(est.reset(log.front()).ok());
+    const test::AllocationCounter counter;
+    for (std::size_t k = 1; k < log.size(); ++k) (void)est.update(log[k]);
+    EXPECT_EQ(counter.count(), 0u);
+  }
+}
+
+// Thresholds that follow |q̇| through CALIB.yaml: written, included, applied; a file without
+// the key (written before it existed) still loads, with constant thresholds; a configuration
+// that sets its own tau_min gets constant thresholds; a bad value is named with file and line.
+TEST(CalibrationFile, SpeedThresholdsRoundTripAndOldFilesStillLoad) {
+  const Model model = paper_arm();
+  CalibrationOptions co;
+  co.thresholds = ThresholdModel::kSpeed;
+  // Torque noise that grows with the speed (0.2 N m s/rad), so that b > 0 comes out.
+  Calibration cal = calibrate(
+      model, no_sensor(),
+      test::simulate_free_motion(model, test::free_motion(0.0, 1.0), test::paper_arm_friction(),
+                                 8.0, Vector6::Zero(), 0.01, 5, {}, Pose(), 0.2),
+      co);
+  ASSERT_EQ(cal.tau_per_speed.size(), 7);
+  EXPECT_GT(cal.tau_per_speed.maxCoeff(), 0.0);
+  for (int i = 0; i < 7; ++i) {
+    const JointFitReport& j = cal.joints[static_cast<std::size_t>(i)];
+    EXPECT_EQ(j.speed_dependent, cal.tau_per_speed[i] > 0.0) << "joint " << i + 1;
+    if (j.speed_dependent) {
+      EXPECT_DOUBLE_EQ(cal.tau_threshold[i], j.threshold_at_rest);
+    }
+  }
+  cal.source = "free.csv";
+  const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_speed";
+  fs::create_directories(dir);
+  const std::string text = calibration_to_yaml(cal, nullptr);
+  ASSERT_NE(text.find("tau_per_speed"), std::string::npos);
+  std::ofstream(dir / "calib.yaml") << text;
+  const std::string robot = (fs::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf").string();
+  const std::string head = "robot: " + robot + "\nsensor: {type: none}\nobserver: {gain: 50}\n";
+  const EstimatorConfig cfg =
+      load_estimator_config_string(head + "calibration: calib.yaml\n", dir / "config.yaml");
+  EXPECT_TRUE(cfg.options.detection.tau_per_speed.isApprox(cal.tau_per_speed, 1e-15));
+  EXPECT_TRUE(cfg.options.detection.tau_min.isApprox(cal.tau_threshold, 1e-15));
+  // The configuration written back keeps the speed term (to_yaml) and reads back the same.
+  const std::string written = to_yaml(cfg, dir);
+  const EstimatorConfig again = load_estimator_config_string(written, dir / "written.yaml");
+  EXPECT_TRUE(again.options.detection.tau_per_speed.isApprox(cal.tau_per_speed, 1e-15));
+  EXPECT_EQ(to_yaml(again, dir), written);
+  // Own tau_min: constant thresholds, the calibration's speed term dropped.
+  const EstimatorConfig own = load_estimator_config_string(
+      head + "detection: {tau_min: 2}\ncalibration: calib.yaml\n", dir / "config.yaml");
+  EXPECT_FALSE((own.options.detection.tau_per_speed.array() > 0.0).any());
+  // A file written before thresholds followed the speed: constant.
+  cal.tau_per_speed = VectorX::Zero(7);
+  const std::string old_text = calibration_to_yaml(cal, nullptr);
+  EXPECT_EQ(old_text.find("tau_per_speed"), std::string::npos);
+  std::ofstream(dir / "old.yaml") << old_text;
+  const EstimatorConfig old =
+      load_estimator_config_string(head + "calibration: old.yaml\n", dir / "config.yaml");
+  EXPECT_FALSE((old.options.detection.tau_per_speed.array() > 0.0).any());
+  ContactEstimator est(model, GeometryModel{}, old.options);
+  EXPECT_FALSE(est.detector().speed_dependent());
+  // A negative slope: the file, its line and the key.
+  std::string bad = text;
+  std::size_t at = bad.find("tau_per_speed: ") + std::string("tau_per_speed: ").size();
+  if (bad[at] == '[') ++at;  // a list: its first value
+  bad.replace(at, bad.find_first_of(",]}", at) - at, "-0.5");
+  std::ofstream(dir / "bad.yaml") << bad;
+  try {
+    (void)load_estimator_config_string(head + "calibration: bad.yaml\n", dir / "config.yaml");
+    FAIL() << "a negative tau_per_speed was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("bad.yaml:"), std::string::npos) << what;
+    EXPECT_NE(what.find("detection.tau_per_speed"), std::string::npos) << what;
+  }
 }
 
 }  // namespace

@@ -73,6 +73,36 @@ TEST(CalibrationPanda, HeldOutFreeMotionStaysQuietAndLightTouchesGetDetectable) 
   EXPECT_LT(rep.min_force_calibrated[7], rep.min_force_constant[7]);
 }
 
+// Thresholds that follow |q̇| (ThresholdModel::kAuto, the default) against the calibration's
+// constant thresholds for the same rate, on the same held-out samples.
+TEST(CalibrationPanda, SpeedThresholdsAgainstConstantOnes) {
+  if (!fs::exists(panda_dir() / "log.csv")) GTEST_SKIP() << "no " << panda_dir();
+  const EstimatorConfig cfg = panda_config();
+  const Model& model = cfg.robot.model;
+  const std::vector<Sample> samples = panda_log(model);
+  const auto first = static_cast<std::size_t>(kFitFraction * static_cast<double>(samples.size()));
+  const std::vector<Sample> fit(samples.begin(), samples.begin() + static_cast<long>(first));
+  const Calibration cal = calibrate(model, cfg.options, fit);
+  const HoldoutReport rep = validate_holdout(model, cfg.options, cal, samples, first);
+  std::printf("held out %d samples: false alarms %d (a + b|dq|), %d (constant)\n", rep.samples,
+              rep.false_alarms, rep.constant_threshold_false_alarms);
+  for (int i = 0; i < 7; ++i) {
+    const JointFitReport& j = cal.joints[static_cast<std::size_t>(i)];
+    std::printf(
+        "joint %d: noise %.3f + %.3f|dq|; threshold %.3f + %.3f|dq| (mean %.3f) vs %.3f "
+        "constant; %s\n",
+        i + 1, j.noise_at_rest, j.noise_per_speed, j.threshold_at_rest, j.threshold_per_speed,
+        j.mean_threshold_speed, j.threshold_constant, j.speed_dependent ? "speed" : "constant");
+  }
+  for (std::size_t l = 1; l <= 7; ++l)
+    std::printf(
+        "link %zu: smallest detectable force at 0.3 m %.3f N (chosen) vs %.3f N "
+        "(constant calibrated) vs %.3f N (best constant, uncalibrated)\n",
+        l, rep.min_force_calibrated[l], rep.min_force_calibrated_constant[l],
+        rep.min_force_constant[l]);
+  EXPECT_LE(rep.false_alarms, kMaxFalseAlarmShare * rep.samples);
+}
+
 // A 15 N push superposed on the real torques (τ − J_lᵀ F) from 80 % of the log on: a point
 // 0.1 m from link l's origin, perpendicular to its joint axis, the force tangential (fixed in
 // the link frame). Detected within 50 ms, on link l, for the wrist links whose thresholds the
@@ -106,21 +136,27 @@ TEST(CalibrationPanda, PushSuperposedOnTheRealTorquesIsDetectedOnTheWrist) {
     ContactEstimator est(model, cfg.robot.geometry, apply_calibration(cfg.options, cal));
     ASSERT_TRUE(est.reset(pushed.front()).ok());
     double delay = -1.0;
-    int isolated = -1;
+    int isolated = -1, isolated_at_window = -1;
     for (std::size_t k = 1; k < pushed.size(); ++k) {
       ASSERT_TRUE(est.update(pushed[k]).ok());
       if (k >= start && delay < 0 && est.result().contact) {
         delay = pushed[k].t - pushed[start].t;
         isolated = est.result().link;
       }
+      // The link when the 50 ms window closes: with thresholds that follow |q̇| a proximal joint
+      // can cross first (joint 4 for a push on link 5), the distal one a few ms later.
+      if (k >= start && isolated_at_window < 0 && pushed[k].t - pushed[start].t >= 0.05)
+        isolated_at_window = est.result().link;
     }
     RecordProperty("push_link" + std::to_string(link),
-                   "delay " + std::to_string(delay) + " s, isolated " + std::to_string(isolated));
-    std::printf("push on link %d: delay %.4f s, isolated link %d\n", link, delay, isolated);
+                   "delay " + std::to_string(delay) + " s, isolated " + std::to_string(isolated) +
+                       ", at 50 ms " + std::to_string(isolated_at_window));
+    std::printf("push on link %d: delay %.4f s, isolated link %d (at 50 ms: %d)\n", link, delay,
+                isolated, isolated_at_window);
     if (link >= 5) {
       EXPECT_GE(delay, 0.0) << "link " << link;
       EXPECT_LE(delay, 0.05) << "link " << link;
-      EXPECT_EQ(isolated, link);
+      EXPECT_EQ(isolated_at_window, link);
     }
   }
 }

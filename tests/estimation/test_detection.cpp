@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "extwrench/core/error.hpp"
 #include "extwrench/estimation/detection.hpp"
 
 namespace extwrench {
@@ -66,6 +67,52 @@ TEST(Detection, ASensorReleaseTheResidualContradictsIsUndoneOnce) {
   const int samples_after = 1000 - static_cast<int>((kForceOff + 0.02) / kDt);
   // Re-declared at release + settle + min_duration, then held to the end.
   EXPECT_GE(r.declared_after_off, samples_after - static_cast<int>((kSettle + 0.012) / kDt));
+}
+
+// Thresholds that follow the motion (docs/calibration.md#thresholds-that-follow-the-motion):
+// τ_thr,i = τ_min,i + b_i |q̇_i|; the same residual is over at rest and under when moving fast.
+TEST(Detection, SpeedThresholdsRiseWithTheJointSpeed) {
+  DetectionOptions options;
+  options.tau_min = VectorX::Constant(kJoints, 1.0);
+  options.tau_per_speed = VectorX::Zero(kJoints);
+  options.tau_per_speed[1] = 2.0;  // joint 2: 1 + 2 |q̇| N m
+  options.min_duration = 0.0;
+  ContactDetector detector(options, kJoints);
+  EXPECT_TRUE(detector.speed_dependent());
+  VectorX tau_ext = VectorX::Zero(kJoints);
+  tau_ext[1] = 1.5;
+  VectorX dq = VectorX::Zero(kJoints);
+  dq[1] = -0.5;  // threshold 2 N m on joint 2
+  detector.set_motion(dq);
+  EXPECT_DOUBLE_EQ(detector.tau_min()[1], 2.0);
+  EXPECT_DOUBLE_EQ(detector.tau_min()[0], 1.0);
+  EXPECT_FALSE(detector.update(0.0, tau_ext, NAN).raw);
+  dq[1] = 0.1;  // threshold 1.2 N m
+  detector.set_motion(dq);
+  const DetectionResult& det = detector.update(kDt, tau_ext, NAN);
+  EXPECT_TRUE(det.contact);
+  EXPECT_EQ(det.link, 2);
+  // Hysteresis at the threshold in force: released below 0.5 × (1 + 2 · 0.8) = 1.3 N m.
+  dq[1] = 0.8;
+  detector.set_motion(dq);
+  EXPECT_TRUE(detector.update(2 * kDt, tau_ext, NAN).contact);
+  tau_ext[1] = 1.2;
+  EXPECT_FALSE(detector.update(3 * kDt, tau_ext, NAN).contact);
+  // Constant thresholds: set_motion changes nothing.
+  ContactDetector constant(DetectionOptions{}, kJoints);
+  EXPECT_FALSE(constant.speed_dependent());
+  constant.set_motion(VectorX::Constant(kJoints, 10.0));
+  EXPECT_DOUBLE_EQ(constant.tau_min()[2], 1.0);
+}
+
+TEST(Detection, SpeedThresholdOptionsAreValidated) {
+  DetectionOptions options;
+  options.tau_per_speed = VectorX::Constant(2, 0.1);
+  EXPECT_THROW(validate(options, kJoints), Error);
+  options.tau_per_speed = VectorX::Constant(1, -0.1);
+  EXPECT_THROW(validate(options, kJoints), Error);
+  options.tau_per_speed = VectorX::Constant(1, 0.1);
+  EXPECT_NO_THROW(validate(options, kJoints));
 }
 
 }  // namespace

@@ -24,7 +24,15 @@
 
 namespace extwrench {
 
+/// The form of the joint thresholds (docs/calibration.md#thresholds-that-follow-the-motion).
+enum class ThresholdModel {
+  kAuto,      ///< a + b|q̇| where its mean over the motion is ≥ 5 % below the constant one
+  kConstant,  ///< τ_thr = a
+  kSpeed,     ///< τ_thr = a + b|q̇| on every joint
+};
+
 struct CalibrationOptions {
+  ThresholdModel thresholds = ThresholdModel::kAuto;
   SmoothSign sign = SmoothSign::kTanh;  ///< tanh or sigmoid (saturation also accepted)
   double smoothing_velocity = 0.0;      ///< > 0: v_s fixed [rad/s]; 0: chosen per joint
   double false_alarms_per_hour = 1.0;   ///< target rate of the thresholds, all joints together
@@ -34,6 +42,20 @@ struct CalibrationOptions {
   double contact_sigma = 12.0;          ///< a contact: residual above this many robust σ ...
   double contact_min_duration = 0.05;   ///< ... for at least this long [s]
   double max_contact_fraction = 0.2;    ///< more suspected contact than this: refused
+  bool payload = false;  ///< identify a payload on the last link (needs a base F/T sensor)
+};
+
+/// A payload identified on a link (docs/calibration.md#payload): mass and CoM from the base
+/// wrench, added to the estimator's model (and to a configured payload on the same link).
+struct PayloadReport {
+  bool identified = false;
+  int body = -1;                         ///< the link carrying it (the last one)
+  double mass = 0.0;                     ///< [kg]
+  Vector3 com = Vector3::Zero();         ///< in that link's frame [m]
+  Vector6 rms_before = Vector6::Zero();  ///< sensor prediction error per axis, bias only
+  Vector6 rms_after = Vector6::Zero();   ///< ... with the payload [N | N m]
+  double condition = 0.0;                ///< of the column-scaled regression
+  int samples = 0;
 };
 
 /// Fit quality of one joint, over the samples used.
@@ -48,6 +70,31 @@ struct JointFitReport {
   double condition = 0.0;           ///< of the column-scaled regression
   double threshold = 0.0;           ///< τ_min for the false-alarm rate [N m]
   bool threshold_from_max = false;  ///< threshold set by margin × max_after (heavier tails)
+  // The noise's growth with speed: std(r | q̇) ≈ noise_at_rest + noise_per_speed |q̇| (a line
+  // through E|r| against |q̇|), and the thresholds a + b|q̇| for the same false-alarm rate.
+  double noise_at_rest = 0.0;         ///< [N m]
+  double noise_per_speed = 0.0;       ///< [N m s/rad]
+  double threshold_constant = 0.0;    ///< the constant threshold for the rate [N m]
+  double threshold_at_rest = 0.0;     ///< a of a + b|q̇| [N m]
+  double threshold_per_speed = 0.0;   ///< b of a + b|q̇| [N m s/rad]
+  double mean_threshold_speed = 0.0;  ///< mean of a + b|q̇| over the samples used [N m]
+  bool speed_dependent = false;       ///< the threshold chosen is a + b|q̇| (b > 0)
+};
+
+/// A recognisable error of the model named by the model check (docs/calibration.md#model-check).
+struct ModelPattern {
+  std::string kind;    ///< base_force_offset | gravity | coulomb | sensor_pose
+  int joint = 0;       ///< 1-based joint, 0 for the base sensor
+  double share = 0.0;  ///< R² of the pattern's regression, or offset / spread
+  std::string message;
+};
+
+/// How well the model predicts free motion before calibration, and what its errors look like.
+struct ModelCheck {
+  VectorX joint_rms;                      ///< residual RMS per joint, model as configured [N m]
+  Vector6 sensor_rms = Vector6::Zero();   ///< reading − prediction per axis (S), bias included
+  Vector6 sensor_mean = Vector6::Zero();  ///< its mean per axis
+  std::vector<ModelPattern> patterns;
 };
 
 /// A time window whose residual does not look like free motion.
@@ -59,13 +106,16 @@ struct SuspectWindow {
 
 struct Calibration {
   JointFriction friction;  ///< viscous, Coulomb, offset, v_s (and φ) per joint
-  VectorX tau_threshold;   ///< detection τ_min per joint (n) [N m]
+  VectorX tau_threshold;   ///< detection τ_min per joint (n) [N m]: a of τ_thr = a + b|q̇|
+  VectorX tau_per_speed;   ///< b per joint (n) [N m s/rad]; empty or zero: constant thresholds
   VectorX observer_gain;   ///< K the residual and thresholds were computed with (n)
   SensorType sensor_type = SensorType::kNone;
   Vector6 sensor_bias_S = Vector6::Zero();  ///< [f; n] in S (moment zero for a force sensor)
   Vector3 force_noise_W = Vector3::Zero();  ///< std of F̂_ext per world axis after the bias [N]
   double force_threshold = 0.0;             ///< F_min after calibration [N] (0: no sensor)
   double false_alarms_per_hour = 1.0;
+  PayloadReport payload;  ///< with CalibrationOptions::payload
+  ModelCheck model_check;
   std::vector<JointFitReport> joints;
   int samples_used = 0;
   double t_begin = 0.0, t_end = 0.0;  ///< time span of the samples given [s]
@@ -84,8 +134,9 @@ struct Calibration {
                                     const std::vector<Sample>& samples,
                                     const CalibrationOptions& calibration_options = {});
 
-/// The options with the calibration applied: friction, detection.tau_min and (with a sensor)
-/// f_min and the sensor bias.
+/// The options with the calibration applied: friction, detection.tau_min and tau_per_speed,
+/// (with a sensor) f_min and the sensor bias, and an identified payload (added to a configured
+/// one on the same body; throws extwrench::Error when the configured one is on another body).
 [[nodiscard]] EstimatorOptions apply_calibration(EstimatorOptions options,
                                                  const Calibration& calibration);
 

@@ -18,14 +18,21 @@ struct HoldoutReport {
   int false_alarms = 0;   ///< samples with a declared contact, calibrated estimator
   int raw_alarms = 0;     ///< samples with some threshold exceeded, calibrated estimator
   int uncalibrated_false_alarms = 0;  ///< the same with the options as configured
-  VectorX calibrated_threshold;       ///< τ_min of the calibration (n)
-  VectorX best_constant_threshold;    ///< max |r_i| without calibration on these samples (n)
-  VectorX calibrated_max_residual;    ///< max |r_i| with calibration on these samples (n)
-  double lever = 0.3;                 ///< [m] from the link origin, ⊥ its joint axis
+  /// The same with the calibration but its constant thresholds (JointFitReport::
+  /// threshold_constant) where it chose a + b|q̇|; equal to false_alarms when all are constant.
+  int constant_threshold_false_alarms = 0;
+  VectorX calibrated_threshold;           ///< τ_min of the calibration (n): a of a + b|q̇|
+  VectorX calibrated_per_speed;           ///< b of a + b|q̇| (n; zero: constant)
+  VectorX calibrated_constant_threshold;  ///< the calibration's constant thresholds (n)
+  VectorX best_constant_threshold;        ///< max |r_i| without calibration on these samples (n)
+  VectorX calibrated_max_residual;        ///< max |r_i| with calibration on these samples (n)
+  double lever = 0.3;                     ///< [m] from the link origin, ⊥ its joint axis
   /// Per link 1..n (index 0 unused): the median over the samples of the smallest force at the
   /// lever point that crosses a threshold (best direction) [N], with the calibrated thresholds
-  /// and with best_constant_threshold.
+  /// (a + b|q̇| at each sample's q̇) and with best_constant_threshold.
   std::vector<double> min_force_calibrated, min_force_constant;
+  /// The same with the calibration's constant thresholds (calibrated_constant_threshold).
+  std::vector<double> min_force_calibrated_constant;
   /// The same with calibrated_max_residual as thresholds: both sides at the smallest constant
   /// thresholds quiet on these samples, with and without calibration.
   std::vector<double> min_force_calibrated_quiet;

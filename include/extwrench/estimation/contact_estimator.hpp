@@ -106,7 +106,8 @@ class ContactEstimator {
   Status acceleration_route(double dt, const Eigen::Ref<const VectorX>& dq,
                             const Eigen::Ref<const VectorX>& tau) noexcept;
   void ground_wrench(const Eigen::Ref<const VectorX>& dq) noexcept;
-  void estimate(double t, const Vector6& reading_S) noexcept;  // stages 5–9
+  void estimate(double t, const Eigen::Ref<const VectorX>& dq,
+                const Vector6& reading_S) noexcept;  // stages 5–9
   BaseWrench base_sensor_reading(const Vector6& reading_S, std::uint32_t& flags) noexcept;
   WrenchFit table_one_case(int link, const BaseWrench& base, std::uint32_t& flags) noexcept;
   double sensor_release_force(const BaseWrench& base) noexcept;

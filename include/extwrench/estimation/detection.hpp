@@ -1,7 +1,9 @@
 // Contact detection and isolation (Sec. II-B, docs/method.md#detection-and-isolation): thresholds
 // with hysteresis and a minimum duration.
 //
-//  - joint i is "over" when |τ̂_ext,i| > τ_min,i and stays over until |τ̂_ext,i| < ratio · τ_min,i;
+//  - joint i is "over" when |τ̂_ext,i| > τ_thr,i and stays over until |τ̂_ext,i| < ratio · τ_thr,i,
+//    with τ_thr,i = τ_min,i + b_i |q̇_i| (b = tau_per_speed, docs/calibration.md; 0 by default:
+//    a constant threshold);
 //    the base force likewise with ‖F̂_ext‖ and F_min (release level = release_ratio × on level);
 //  - the raw detection is "any joint or the base force over"; a contact is declared once the raw
 //    detection has held for min_duration seconds and released once it has been off for
@@ -23,9 +25,11 @@ namespace extwrench {
 
 struct DetectionOptions {
   VectorX tau_min = VectorX::Constant(1, 1.0);  ///< τ_min [N m | N]: size 1 (all joints) or n
-  double f_min = 5.0;                           ///< F_min on ‖F̂_ext‖ from the base sensor [N]
-  double release_ratio = 0.5;                   ///< off level = ratio × on level, in (0, 1]
-  double min_duration = 0.005;                  ///< [s] ≥ 0, for both onset and release
+  /// b ≥ 0 of τ_thr,i = τ_min,i + b_i |q̇_i| [N m s/rad]: size 0 (none), 1 (all joints) or n.
+  VectorX tau_per_speed;
+  double f_min = 5.0;           ///< F_min on ‖F̂_ext‖ from the base sensor [N]
+  double release_ratio = 0.5;   ///< off level = ratio × on level, in (0, 1]
+  double min_duration = 0.005;  ///< [s] ≥ 0, for both onset and release
 };
 
 struct DetectionResult {
@@ -50,6 +54,9 @@ class ContactDetector {
                   double release_settle_time = std::numeric_limits<double>::infinity());
 
   void reset() noexcept;
+  /// The thresholds for the current joint velocities: τ_thr = τ_min + b ∘ |q̇| (no-op without
+  /// tau_per_speed). Call before update() with the sample's q̇ (finite, size n). No allocation.
+  void set_motion(const Eigen::Ref<const VectorX>& dq) noexcept;
   /// τ̂_ext (n) and ‖F̂_ext‖ (NaN when there is no usable base force) at time t. No allocation.
   /// release_force_norm: the sensor's instantaneous force (docs/estimator.md#release-from-the-
   /// sensor), NaN when unknown. When finite, a declared contact is released once it falls below
@@ -65,12 +72,18 @@ class ContactDetector {
                                 double release_force_norm = kNoReleaseForce) noexcept;
   static constexpr double kNoReleaseForce = std::numeric_limits<double>::quiet_NaN();
   [[nodiscard]] const DetectionResult& result() const noexcept { return result_; }
-  [[nodiscard]] const VectorX& tau_min() const noexcept { return tau_min_; }
+  /// The joint thresholds in force (τ_min + b ∘ |q̇| at the last set_motion; τ_min when constant).
+  [[nodiscard]] const VectorX& tau_min() const noexcept { return threshold_; }
+  /// Whether the thresholds follow |q̇| (tau_per_speed given and not all zero).
+  [[nodiscard]] bool speed_dependent() const noexcept { return speed_dependent_; }
   [[nodiscard]] const DetectionOptions& options() const noexcept { return options_; }
 
  private:
   DetectionOptions options_;
-  VectorX tau_min_;  ///< (n)
+  VectorX tau_min_;    ///< a: constant part (n)
+  VectorX tau_speed_;  ///< b: per |q̇| (n; zero when constant)
+  VectorX threshold_;  ///< τ_thr in force (n)
+  bool speed_dependent_ = false;
   Eigen::Matrix<bool, Eigen::Dynamic, 1> joint_over_;
   bool base_over_ = false;
   bool declared_ = false;
@@ -84,7 +97,7 @@ class ContactDetector {
   bool sensor_release_disproved_ = false;  ///< no sensor release until every threshold drops
   DetectionResult result_;
 
-  /// max(|τ̂_ext,i| / τ_min,i, ‖F̂‖ / F_min): how far over its threshold the strongest signal is.
+  /// max(|τ̂_ext,i| / τ_thr,i, ‖F̂‖ / F_min): how far over its threshold the strongest signal is.
   [[nodiscard]] double level(const Eigen::Ref<const VectorX>& tau_ext,
                              double base_force_norm) const noexcept;
 };

@@ -5,7 +5,8 @@
 //   observer: {gain: [...]}            # K the thresholds were computed with
 //   friction: {sign: tanh, viscous: [...], coulomb: [...], offset: [...],
 //              smoothing_velocity: [...]}      # (velocity_shift: [...] for the sigmoid)
-//   detection: {tau_min: [...], f_min: F}      # f_min with a base sensor only
+//   detection: {tau_min: [...], tau_per_speed: [...], f_min: F}
+//              # tau_per_speed (thresholds a + b|q̇|) only when some b > 0; f_min with a sensor
 //   sensor: {type: ft, bias: [fx, fy, fz, mx, my, mz]}
 //   fit: {...}      # report: per-joint RMS before/after, variance explained, condition, ...
 //   holdout: {...}  # report of --holdout

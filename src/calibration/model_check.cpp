@@ -1,0 +1,158 @@
+#include "model_check.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace extwrench::calibration_detail {
+namespace {
+
+// A pattern is named when its regression explains at least this share of the variance.
+constexpr double kJointShare = 0.3;
+constexpr double kPoseShare = 0.5;
+// A base-force offset is named when its mean exceeds this many standard deviations of the rest.
+constexpr double kOffsetSpreads = 2.0;
+
+std::string num(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", x);
+  return b;
+}
+
+// R² and slope of y on [1, x] over the used samples.
+struct Line {
+  double r2 = 0.0, slope = 0.0;
+};
+Line line_fit(const std::vector<double>& y, const std::vector<double>& x,
+              const std::vector<char>& use) {
+  double n = 0, sx = 0, sy = 0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    if (!use[k]) continue;
+    n += 1;
+    sx += x[k];
+    sy += y[k];
+  }
+  if (n < 3) return {};
+  const double mx = sx / n, my = sy / n;
+  double sxx = 0, sxy = 0, syy = 0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    if (!use[k]) continue;
+    sxx += (x[k] - mx) * (x[k] - mx);
+    sxy += (x[k] - mx) * (y[k] - my);
+    syy += (y[k] - my) * (y[k] - my);
+  }
+  if (sxx <= 1e-300 || syy <= 1e-300) return {};
+  return {sxy * sxy / (sxx * syy), sxy / sxx};
+}
+
+}  // namespace
+
+void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
+                  const std::vector<JointFrictionFit>& after,
+                  const std::vector<std::vector<double>>& gravity, const std::vector<char>& use,
+                  ModelCheck& check) {
+  const std::size_t n = series.size();
+  check.joint_rms = VectorX::Zero(static_cast<Eigen::Index>(n));
+  std::vector<double> phi, z;
+  for (std::size_t i = 0; i < n; ++i) {
+    const JointSeries& s = series[i];
+    const int joint = static_cast<int>(i) + 1;
+    double sum2 = 0, count = 0;
+    for (std::size_t k = 0; k < s.r0.size(); ++k) {
+      if (!use[k]) continue;
+      sum2 += before[i].r0[k] * before[i].r0[k];
+      count += 1;
+    }
+    check.joint_rms[static_cast<Eigen::Index>(i)] = count > 0 ? std::sqrt(sum2 / count) : 0.0;
+    // Flips with sign(q̇): the model's residual against the observer-filtered sign.
+    phi.assign(s.dq.size(), 0.0);
+    for (std::size_t k = 0; k < s.dq.size(); ++k)
+      phi[k] = s.dq[k] > 0 ? 1.0 : (s.dq[k] < 0 ? -1.0 : 0.0);
+    filter_regressor(phi, s.alpha, z);
+    const Line coulomb = line_fit(before[i].r0, z, use);
+    if (coulomb.r2 >= kJointShare) {
+      check.patterns.push_back({"coulomb", joint, coulomb.r2,
+                                "joint " + std::to_string(joint) +
+                                    ": the residual flips with sign(dq) (" +
+                                    num(std::abs(coulomb.slope)) + " N m, R^2 " + num(coulomb.r2) +
+                                    "): Coulomb friction the model lacks (calibrated)"});
+    }
+    // Follows g(q): the calibrated residual against the filtered gravity torque.
+    filter_regressor(gravity[i], s.alpha, z);
+    const Line g = line_fit(after[i].residual, z, use);
+    if (g.r2 >= kJointShare) {
+      check.patterns.push_back(
+          {"gravity", joint, g.r2,
+           "joint " + std::to_string(joint) + ": the calibrated residual follows g(q) (" +
+               num(100.0 * g.slope) + " % of it, R^2 " + num(g.r2) +
+               "): a gravity / mass error in the model (a payload? --payload with a F/T sensor)"});
+    }
+  }
+}
+
+void check_sensor(const std::vector<Vector6>& error_S, const std::vector<Vector6>& predicted_S,
+                  bool moments, ModelCheck& check) {
+  const auto N = static_cast<double>(error_S.size());
+  if (N < 3) return;
+  Vector6 mean = Vector6::Zero(), mean_p = Vector6::Zero();
+  for (std::size_t k = 0; k < error_S.size(); ++k) {
+    mean += error_S[k];
+    mean_p += predicted_S[k];
+  }
+  mean /= N;
+  mean_p /= N;
+  Vector6 var = Vector6::Zero(), ms = Vector6::Zero();
+  for (const Vector6& e : error_S) {
+    var += (e - mean).cwiseAbs2();
+    ms += e.cwiseAbs2();
+  }
+  check.sensor_mean = mean;
+  check.sensor_rms = (ms / N).cwiseSqrt();
+  const Vector3 spread = (var.head<3>() / N).cwiseSqrt();
+  const Vector3 offset = mean.head<3>();
+  if (offset.norm() > kOffsetSpreads * spread.norm() && offset.norm() > 1e-3) {
+    check.patterns.push_back(
+        {"base_force_offset", 0, offset.norm() / std::max(spread.norm(), 1e-12),
+         "base force: a constant offset of [" + num(offset.x()) + ", " + num(offset.y()) + ", " +
+             num(offset.z()) + "] N (" + num(offset.norm() / std::max(spread.norm(), 1e-12)) +
+             " x its spread): a sensor bias (calibrated out) or a mass error in the model"});
+  }
+  if (!moments) return;
+  // Sensor moment error linear in the predicted wrench as the configuration changes: a sensor
+  // orientation error δθ adds δθ × n̂ to the moment (and a constant δθ × f̂ ≈ −δθ × M g to the
+  // force, taken as bias). Least squares of each moment axis on the predicted moment.
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d B = Eigen::Matrix3d::Zero();
+  for (std::size_t k = 0; k < error_S.size(); ++k) {
+    const Vector3 p = predicted_S[k].tail<3>() - mean_p.tail<3>();
+    const Vector3 e = error_S[k].tail<3>() - mean.tail<3>();
+    A += p * p.transpose();
+    B += p * e.transpose();
+  }
+  if (A.trace() <= 1e-300) return;
+  const Eigen::Matrix3d coeff =
+      (A + 1e-12 * A.trace() * Eigen::Matrix3d::Identity()).ldlt().solve(B);
+  double best = 0.0;
+  int axis = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double total = var[3 + a];
+    if (total <= 1e-300) continue;
+    const double explained = (coeff.col(a).transpose() * A * coeff.col(a))(0, 0);
+    const double r2 = explained / total;
+    if (r2 > best) {
+      best = r2;
+      axis = a;
+    }
+  }
+  if (best >= kPoseShare) {
+    const char* names[] = {"x", "y", "z"};
+    check.patterns.push_back(
+        {"sensor_pose", 0, best,
+         std::string("base moment: the error about ") + names[axis] +
+             " is linear in the predicted moment as the configuration changes (R^2 " + num(best) +
+             "): a sensor pose (orientation) error in the configuration"});
+  }
+}
+
+}  // namespace extwrench::calibration_detail
