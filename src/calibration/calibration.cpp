@@ -469,20 +469,26 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   return cal;
 }
 
+bool add_identified_payload(const Calibration& calibration, EstimatorOptions& options) {
+  if (!calibration.payload.identified) return true;
+  Inertia identified;
+  identified.mass = calibration.payload.mass;
+  identified.com = calibration.payload.com;
+  if (!options.payload) {
+    options.payload = PayloadOptions{calibration.payload.body, identified};
+  } else if (options.payload->body == calibration.payload.body) {
+    options.payload->inertia = options.payload->inertia + identified;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 EstimatorOptions apply_calibration(EstimatorOptions options, const Calibration& calibration) {
-  if (calibration.payload.identified) {
-    Inertia identified;
-    identified.mass = calibration.payload.mass;
-    identified.com = calibration.payload.com;
-    if (!options.payload) {
-      options.payload = PayloadOptions{calibration.payload.body, identified};
-    } else if (options.payload->body == calibration.payload.body) {
-      options.payload->inertia = options.payload->inertia + identified;
-    } else {
-      throw Error("calibration: the identified payload is on body " +
-                  std::to_string(calibration.payload.body) + ", the configured one on body " +
-                  std::to_string(options.payload->body));
-    }
+  if (!add_identified_payload(calibration, options)) {
+    throw Error("calibration: the identified payload is on body " +
+                std::to_string(calibration.payload.body) + ", the configured one on body " +
+                std::to_string(options.payload->body));
   }
   options.friction = calibration.friction;
   options.detection.tau_min = calibration.tau_threshold;

@@ -6,6 +6,7 @@
 
 #include "detail/friction_yaml.hpp"
 #include "detail/yaml_reader.hpp"
+#include "extwrench/calibration/calibration.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/calibration_file.hpp"
 #include "extwrench/model/model_builder.hpp"
@@ -141,20 +142,11 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
   // The speed term belongs to the calibration's τ_min: taken with it, unless set here.
   if (!(det && (det["tau_min"] || det["tau_per_speed"])))
     o.detection.tau_per_speed = cal.tau_per_speed;
-  if (cal.payload.identified) {  // added to a configured payload on the same link
-    Inertia identified;
-    identified.mass = cal.payload.mass;
-    identified.com = cal.payload.com;
-    if (!o.payload) {
-      o.payload = PayloadOptions{cal.payload.body, identified};
-    } else if (o.payload->body == cal.payload.body) {
-      o.payload->inertia = o.payload->inertia + identified;
-    } else {
-      rd.fail(node, "calibration",
-              "'" + path.string() +
-                  "' identified a payload on the last link, this "
-                  "configuration has one on another link");
-    }
+  if (!add_identified_payload(cal, o)) {
+    rd.fail(node, "calibration",
+            "'" + path.string() +
+                "' identified a payload on the last link, this configuration has one on another "
+                "link");
   }
   if (cal.sensor_type != SensorType::kNone) {
     if (!(det && det["f_min"])) o.detection.f_min = cal.force_threshold;

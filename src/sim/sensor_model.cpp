@@ -20,6 +20,14 @@ double EncoderModel::quantize(double q) const noexcept {
 JointSensor::JointSensor(EncoderModel model, int n)
     : model_(model), last_q_(VectorX::Zero(n)), last_dq_(VectorX::Zero(n)) {}
 
+void BaseSensorModel::write_reading(const Vector6& ideal, Rng& rng, Sample& out) const noexcept {
+  out.reading_S = measure(ideal, rng);
+  out.has_force = type != SensorType::kNone;
+  out.has_moment = type == SensorType::kForceTorque;
+  if (!out.has_force) out.reading_S.setZero();
+  if (!out.has_moment) out.reading_S.tail<3>().setZero();
+}
+
 void JointSensor::measure(double t, const VectorX& q, const VectorX& dq, VectorX& q_out,
                           VectorX& dq_out) noexcept {
   for (Eigen::Index i = 0; i < q.size(); ++i) q_out[i] = model_.quantize(q[i]);

@@ -117,11 +117,7 @@ bool Simulator::next(Sample& out) {
   const VectorX ddq = ws_.data.ddq;
   rnea(model_, ws_.data, q_, dq_, ddq, ws_.wrenches);
   const Vector6 ideal = sensor_reading(ws_.data, config_.sensor.X_WS);
-  out.reading_S = config_.sensor.measure(ideal, noise_);
-  out.has_force = config_.sensor.type != SensorType::kNone;
-  out.has_moment = config_.sensor.type == SensorType::kForceTorque;
-  if (!out.has_force) out.reading_S.setZero();
-  if (!out.has_moment) out.reading_S.tail<3>().setZero();
+  config_.sensor.write_reading(ideal, noise_, out);
 
   out.has_truth = true;
   out.has_true_tau_ext = true;

@@ -2,11 +2,11 @@
 #include "extwrench/bridges/mujoco_engine.hpp"
 
 #include <mujoco/mujoco.h>
+#include <tinyxml2.h>
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <regex>
 #include <sstream>
 
 #include "extwrench/core/error.hpp"
@@ -109,66 +109,102 @@ std::string robot_label(const Scenario& s) {
 
 }  // namespace
 
+namespace {
+
+// `text` (one element, e.g. "<site .../>") parsed and copied into `doc`.
+tinyxml2::XMLNode* element(tinyxml2::XMLDocument& doc, const std::string& text) {
+  tinyxml2::XMLDocument snippet;
+  if (snippet.Parse(text.c_str()) != tinyxml2::XML_SUCCESS || snippet.RootElement() == nullptr)
+    throw Error("scene_mjcf: internal MJCF snippet does not parse: " + text);
+  return snippet.RootElement()->DeepClone(&doc);
+}
+
+// The <body name="NAME"> below `parent` (depth first), or nullptr.
+tinyxml2::XMLElement* find_body(tinyxml2::XMLElement* parent, const std::string& name) {
+  for (tinyxml2::XMLElement* b = parent->FirstChildElement("body"); b != nullptr;
+       b = b->NextSiblingElement("body")) {
+    const char* n = b->Attribute("name");
+    if (n != nullptr && name == n) return b;
+    if (tinyxml2::XMLElement* found = find_body(b, name)) return found;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
 std::string scene_mjcf(const Scenario& s, const Pose& X_WS, const Pose& X_mj_root,
                        const std::vector<std::string>& robot_bodies) {
-  std::string xml = read_input_file(s.robot_path, "robot");
+  const std::string text = read_input_file(s.robot_path, "robot");
   const std::string label = robot_label(s);
-  const auto root_tag = std::regex_search(xml, std::regex("<mujoco[\\s>]"));
-  if (!root_tag) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(text.c_str()) != tinyxml2::XML_SUCCESS) {
+    throw Error(label + ":" + std::to_string(doc.ErrorLineNum()) + ": not XML: " + doc.ErrorStr());
+  }
+  tinyxml2::XMLElement* mujoco = doc.RootElement();
+  if (mujoco == nullptr || std::strcmp(mujoco->Name(), "mujoco") != 0) {
     throw Error(label + ": engine: mujoco needs an MJCF robot (root element <mujoco>)");
   }
+  tinyxml2::XMLElement* worldbody = mujoco->FirstChildElement("worldbody");
+  if (worldbody == nullptr) throw Error(label + ": no <worldbody> in the file's own text");
   // The base sensor: a site at X_WS on the root body (W is the root's frame) with a <force>
   // and a <torque> sensor.
   const std::string site = std::string("<site name=\"") + kSceneSensorSite + "\" " +
                            pose_attributes(X_WS) + " size=\"0.005\"/>";
   const std::string& root = s.robot.model.bodies[0].name;
-  std::smatch match;
-  const std::regex body_tag(
-      "<body\\b[^>]*\\bname\\s*=\\s*[\"']" +
-      std::regex_replace(root, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") + "[\"'][^>]*>");
-  const std::regex worldbody_tag("<worldbody\\s*>");
-  std::string obstacles;
-  for (const Obstacle& o : s.obstacles) {
-    Pose X = X_mj_root * o.pose;
-    if (o.motion == Obstacle::Motion::kFixed) {
-      std::string geom = obstacle_geom(o, false);
-      geom.replace(geom.find("POSE"), 4, pose_attributes(X));
-      obstacles += "\n    " + geom;
-    } else {
-      obstacles += "\n    <body name=\"" + std::string(kSceneObstaclePrefix) + o.name +
-                   "\" mocap=\"true\" " + pose_attributes(X) + ">" + obstacle_geom(o, true) +
-                   "</body>";
-    }
-  }
-  if (std::regex_search(xml, match, body_tag) && match.str().back() == '>' &&
-      match.str()[match.str().size() - 2] != '/') {
-    xml.insert(static_cast<std::size_t>(match.position() + match.length()), site);
+  tinyxml2::XMLElement* root_body = nullptr;
+  for (tinyxml2::XMLElement* w = worldbody; w != nullptr && root_body == nullptr;
+       w = w->NextSiblingElement("worldbody"))
+    root_body = find_body(w, root);
+  if (root_body != nullptr) {
+    root_body->InsertFirstChild(element(doc, site));
   } else if (root == "world") {
-    obstacles += "\n    " + site;
+    worldbody->InsertFirstChild(element(doc, site));
   } else {
     throw Error(label + ": the root body '" + root +
                 "' is not in the file's own text (in an <include>d file?): engine: mujoco adds "
                 "the base sensor to it");
   }
-  if (!std::regex_search(xml, match, worldbody_tag))
-    throw Error(label + ": no <worldbody> in the file's own text");
-  xml.insert(static_cast<std::size_t>(match.position() + match.length()), obstacles);
-  const std::size_t end = xml.rfind("</mujoco>");
-  if (end == std::string::npos) throw Error(label + ": no </mujoco>");
+  // The obstacles, first in the world body, in their order.
+  tinyxml2::XMLNode* previous = nullptr;
+  for (const Obstacle& o : s.obstacles) {
+    const Pose X = X_mj_root * o.pose;
+    std::string obstacle;
+    if (o.motion == Obstacle::Motion::kFixed) {
+      obstacle = obstacle_geom(o, false);
+      obstacle.replace(obstacle.find("POSE"), 4, pose_attributes(X));
+    } else {
+      obstacle = "<body name=\"" + std::string(kSceneObstaclePrefix) + o.name +
+                 "\" mocap=\"true\" " + pose_attributes(X) + ">" + obstacle_geom(o, true) +
+                 "</body>";
+    }
+    tinyxml2::XMLNode* node = element(doc, obstacle);
+    previous = previous == nullptr ? worldbody->InsertFirstChild(node)
+                                   : worldbody->InsertAfterChild(previous, node);
+  }
   // No self-collisions: a contact between two links of the robot is internal (no external
   // wrench, not in the truth) but acts on the joints between them.
-  std::string excludes;
-  for (std::size_t a = 0; a < robot_bodies.size(); ++a) {
-    for (std::size_t b = a + 1; b < robot_bodies.size(); ++b) {
-      excludes +=
-          "    <exclude body1=\"" + robot_bodies[a] + "\" body2=\"" + robot_bodies[b] + "\"/>\n";
+  if (robot_bodies.size() > 1) {
+    tinyxml2::XMLElement* contact = doc.NewElement("contact");
+    for (std::size_t a = 0; a < robot_bodies.size(); ++a) {
+      for (std::size_t b = a + 1; b < robot_bodies.size(); ++b) {
+        tinyxml2::XMLElement* exclude = contact->InsertNewChildElement("exclude");
+        exclude->SetAttribute("body1", robot_bodies[a].c_str());
+        exclude->SetAttribute("body2", robot_bodies[b].c_str());
+      }
     }
+    mujoco->InsertEndChild(contact);
   }
-  if (!excludes.empty()) xml.insert(end, "  <contact>\n" + excludes + "  </contact>\n");
-  xml.insert(end, std::string("  <sensor>\n    <force name=\"") + kSceneForceSensor + "\" site=\"" +
-                      kSceneSensorSite + "\"/>\n    <torque name=\"" + kSceneTorqueSensor +
-                      "\" site=\"" + kSceneSensorSite + "\"/>\n  </sensor>\n");
-  return xml;
+  tinyxml2::XMLElement* sensor = doc.NewElement("sensor");
+  for (const auto& [type, name] :
+       {std::pair{"force", kSceneForceSensor}, std::pair{"torque", kSceneTorqueSensor}}) {
+    tinyxml2::XMLElement* e = sensor->InsertNewChildElement(type);
+    e->SetAttribute("name", name);
+    e->SetAttribute("site", kSceneSensorSite);
+  }
+  mujoco->InsertEndChild(sensor);
+  tinyxml2::XMLPrinter printer;
+  doc.Print(&printer);
+  return printer.CStr();
 }
 
 MujocoSimulator::MujocoSimulator(const Scenario& s, sim::ComputedTorqueController controller,
@@ -307,11 +343,7 @@ bool MujocoSimulator::next(Sample& out) {
   out.q = qm_;
   out.dq = dqm_;
   out.tau = s.tau;
-  out.reading_S = config_.sensor.measure(s.reading_S, noise_);
-  out.has_force = config_.sensor.type != SensorType::kNone;
-  out.has_moment = config_.sensor.type == SensorType::kForceTorque;
-  if (!out.has_force) out.reading_S.setZero();
-  if (!out.has_moment) out.reading_S.tail<3>().setZero();
+  config_.sensor.write_reading(s.reading_S, noise_, out);
   out.has_truth = true;
   out.has_true_tau_ext = true;
   out.truth = s.truth;

@@ -134,6 +134,12 @@ struct Calibration {
                                     const std::vector<Sample>& samples,
                                     const CalibrationOptions& calibration_options = {});
 
+/// Adds the calibration's identified payload (if any) to options.payload: set when there is
+/// none, summed with a configured payload on the same body. False, options unchanged, when the
+/// configured payload is on another body (the caller says so, in its own terms).
+[[nodiscard]] bool add_identified_payload(const Calibration& calibration,
+                                          EstimatorOptions& options);
+
 /// The options with the calibration applied: friction, detection.tau_min and tau_per_speed,
 /// (with a sensor) f_min and the sensor bias, and an identified payload (added to a configured
 /// one on the same body; throws extwrench::Error when the configured one is on another body).

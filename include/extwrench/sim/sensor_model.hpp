@@ -3,6 +3,7 @@
 
 #include <cstdint>
 
+#include "extwrench/core/sample.hpp"
 #include "extwrench/core/types.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/sim/random.hpp"
@@ -22,6 +23,9 @@ struct BaseSensorModel {
   /// Ideal reading + bias + noise. Noise is drawn for all six axes every call (whatever the
   /// type), so the stream does not depend on the sensor type.
   [[nodiscard]] Vector6 measure(const Vector6& ideal, Rng& rng) const noexcept;
+  /// A sample's reading from the ideal one: measure(), then what the type reports (has_force,
+  /// has_moment; the axes it does not have are 0). Every simulator fills its samples so.
+  void write_reading(const Vector6& ideal, Rng& rng, Sample& out) const noexcept;
 };
 
 /// Joint encoders and the velocity the robot reports.
