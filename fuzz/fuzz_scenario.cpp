@@ -5,10 +5,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <system_error>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/scenario_config.hpp"
+#include "extwrench/sim/controller.hpp"
+#include "extwrench/sim/sample_source.hpp"
 #include "fuzz_input_file.hpp"
 
 namespace {
@@ -21,10 +24,19 @@ std::filesystem::path scenario_path() {
   return dir / "scenarios" / "fuzz.yaml";
 }
 
+// Stands in for extwrench::mujoco's engine, which this harness does not link: with an engine
+// registered, `engine: mujoco` is accepted and its `obstacles:` are parsed (never run here).
+std::unique_ptr<extwrench::sim::SampleSource> no_engine(const extwrench::Scenario&,
+                                                        extwrench::sim::ComputedTorqueController,
+                                                        const extwrench::sim::SimulationConfig&) {
+  return nullptr;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::filesystem::path path = scenario_path();
+  extwrench::set_mujoco_engine(no_engine);
   if (!extwrench_fuzz::write_input(path, data, size)) return 0;
   extwrench::LoadOptions options;
   options.load_meshes = false;  // no file access from fuzzed mesh names
