@@ -24,6 +24,7 @@ struct CalibrateOptions {
   double false_alarms_per_hour = 1.0;
   std::string thresholds = "auto";
   bool payload = false;
+  bool known_torque = false;
   std::vector<std::filesystem::path> package_path;
 };
 
@@ -35,7 +36,7 @@ std::vector<Sample> read_log(const std::filesystem::path& path, const Model& mod
   return samples;
 }
 
-void print_report(const Calibration& c, const HoldoutReport* h) {
+void print_report(const Calibration& c, const HoldoutReport* h, bool in_contact) {
   std::cout << "  joint  viscous  coulomb   offset   v_s    rms before -> after  var.expl  "
                "threshold\n";
   for (std::size_t i = 0; i < c.joints.size(); ++i) {
@@ -77,7 +78,10 @@ void print_report(const Calibration& c, const HoldoutReport* h) {
     std::cerr << "extwrench calibrate: warning: " << w << "\n";
   if (h == nullptr) return;
   std::cout << "  holdout: " << h->samples << " samples (" << fmt(h->duration)
-            << " s): " << h->false_alarms << " false-alarm samples ("
+            << " s): " << h->false_alarms
+            << (in_contact ? " samples with contact declared (the log is in contact: not false "
+                             "alarms) ("
+                           : " false-alarm samples (")
             << fmt(h->samples ? 100.0 * h->false_alarms / h->samples : 0.0) << " %), uncalibrated "
             << h->uncalibrated_false_alarms << ", calibrated with constant thresholds "
             << h->constant_threshold_false_alarms << "\n"
@@ -94,6 +98,12 @@ void print_report(const Calibration& c, const HoldoutReport* h) {
     std::cout << "  " << l << "      " << fmt(h->min_force_calibrated[l]) << " ("
               << fmt(h->min_force_calibrated_constant[l]) << ") | " << fmt(h->min_force_constant[l])
               << "  " << fmt(h->min_force_calibrated_quiet[l]) << "\n";
+  if (h->tracking_rms_calibrated.size() == 0) return;
+  std::cout << "  joint  RMS of residual - true_tau_ext on the holdout [N m]: uncalibrated -> "
+               "calibrated\n";
+  for (Eigen::Index i = 0; i < h->tracking_rms_calibrated.size(); ++i)
+    std::cout << "  " << i + 1 << "      " << fmt(h->tracking_rms_uncalibrated[i]) << " -> "
+              << fmt(h->tracking_rms_calibrated[i]) << "\n";
 }
 
 void run_calibrate(const CalibrateOptions& opt) {
@@ -112,6 +122,7 @@ void run_calibrate(const CalibrateOptions& opt) {
     throw UsageError("--false-alarms-per-hour: expected a value > 0");
   co.smoothing_velocity = opt.smoothing_velocity;
   co.payload = opt.payload;
+  co.known_external_torque = opt.known_torque;
   co.false_alarms_per_hour = opt.false_alarms_per_hour;
   if (opt.thresholds == "auto") {
     co.thresholds = ThresholdModel::kAuto;
@@ -152,7 +163,7 @@ void run_calibrate(const CalibrateOptions& opt) {
   std::cout << "extwrench calibrate: " << samples.size() << " rows, fit on " << fit.size() << " ("
             << cal.samples_used << " used) in " << fmt(seconds) << " s -> " << opt.out.string()
             << "\n";
-  print_report(cal, holdout ? &*holdout : nullptr);
+  print_report(cal, holdout ? &*holdout : nullptr, opt.known_torque);
 }
 
 }  // namespace
@@ -191,6 +202,11 @@ void register_calibrate(CLI::App& app) {
   sub->add_flag("--payload", opt->payload,
                 "Identify a payload (mass, CoM) on the last link from the base F/T sensor and add "
                 "it to the model (needs sensor.type: ft)");
+  sub->add_flag("--known-torque", opt->known_torque,
+                "The log is not contact-free but its true_tau_ext1..n columns hold the external "
+                "torque known during the recording (e.g. J_v^T F of a force plate under the "
+                "contact): it is taken out of the residual before the fit (needs sensor.type: "
+                "none)");
   add_package_path_option(*sub, opt->package_path);
   sub->callback([opt]() { run_calibrate(*opt); });
 }

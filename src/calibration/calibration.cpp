@@ -26,10 +26,14 @@ constexpr double kMadToSigma = 1.4826;  // σ of a Gaussian from its median abso
 // constant threshold for the same rate.
 constexpr double kSpeedGain = 0.95;
 
-void check_samples(const std::vector<Sample>& samples, int n) {
+void check_samples(const std::vector<Sample>& samples, int n, bool known_external_torque) {
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const Sample& s = samples[k];
     const std::string where = "sample " + std::to_string(k) + " (t = " + std::to_string(s.t) + ")";
+    if (known_external_torque && !s.has_true_tau_ext) {
+      throw Error(where +
+                  ": no known external torque (true_tau_ext1..n) for a calibration in contact");
+    }
     if (!std::isfinite(s.t)) throw Error(where + ": t is not finite");
     if (k > 0 && !(s.t > samples[k - 1].t)) throw Error(where + ": t does not increase");
     auto check = [&](const VectorX& v, const char* name) {
@@ -44,7 +48,19 @@ void check_samples(const std::vector<Sample>& samples, int n) {
     check(s.q, "q");
     check(s.dq, "dq");
     check(s.tau, "tau");
+    if (known_external_torque) check(s.truth.tau_ext, "true_tau_ext");
   }
+}
+
+// With a known external torque: the residual's part due to it, the observer's filter of
+// τ_ext,known (the residual answers an external torque as it answers friction, with the
+// opposite sign), taken out of r⁰ so that only the model's error is left to fit.
+void remove_known_torque(const std::vector<Sample>& samples, const std::vector<double>& alpha,
+                         int joint, std::vector<double>& r0) {
+  std::vector<double> tau_ext(samples.size()), filtered;
+  for (std::size_t k = 0; k < samples.size(); ++k) tau_ext[k] = samples[k].truth.tau_ext[joint];
+  calibration_detail::filter_regressor(tau_ext, alpha, filtered);
+  for (std::size_t k = 0; k < r0.size(); ++k) r0[k] -= filtered[k];
 }
 
 // The observer over the log with `friction`: residual r_k per joint (N × n), and e^{−K Δt_k}.
@@ -349,7 +365,12 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
                       const std::vector<Sample>& samples, const CalibrationOptions& o) {
   const int n = model.nq();
   validate(options, model);
-  check_samples(samples, n);
+  if (o.known_external_torque && options.sensor.type != SensorType::kNone) {
+    throw Error(
+        "calibration: a known external torque is for configurations without a base sensor "
+        "(sensor.type: none): the sensor's bias would absorb the contact force");
+  }
+  check_samples(samples, n, o.known_external_torque);
   const VectorX gains = MomentumObserver::checked_gains(options.observer_gain, n);
   const double settle =
       o.settle_time >= 0 ? o.settle_time : kSettleTimeConstants / gains.minCoeff();
@@ -402,6 +423,12 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   run_observer(m, gains, JointFriction::none(n), samples, series, false);
   run_observer(m, gains, options.friction ? *options.friction : JointFriction::from_model(model),
                samples, before, true);
+  if (o.known_external_torque) {
+    for (std::size_t i = 0; i < series.size(); ++i) {
+      remove_known_torque(samples, series[i].alpha, static_cast<int>(i), series[i].r0);
+      remove_known_torque(samples, series[i].alpha, static_cast<int>(i), before[i].r0);
+    }
+  }
 
   cal.observer_gain = gains;
   cal.sensor_type = options.sensor.type;

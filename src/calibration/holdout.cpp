@@ -64,6 +64,10 @@ HoldoutReport validate_holdout(const Model& model, const EstimatorOptions& optio
   const bool speed = (rep.calibrated_per_speed.array() > 0.0).any();
   rep.best_constant_threshold = VectorX::Zero(n);
   rep.calibrated_max_residual = VectorX::Zero(n);
+  const bool known_torque =
+      std::all_of(samples.begin() + static_cast<std::ptrdiff_t>(first), samples.end(),
+                  [](const Sample& s) { return s.has_true_tau_ext; });
+  VectorX sum_sq_plain = VectorX::Zero(n), sum_sq_cal = VectorX::Zero(n);
   if (!plain.reset(samples.front()).ok() || !calibrated.reset(samples.front()).ok() ||
       (speed && !constant_est.reset(samples.front()).ok()))
     throw Error("holdout: estimator reset failed on the first sample");
@@ -82,6 +86,14 @@ HoldoutReport validate_holdout(const Model& model, const EstimatorOptions& optio
         rep.best_constant_threshold.cwiseMax(plain.result().residual.cwiseAbs());
     rep.calibrated_max_residual =
         rep.calibrated_max_residual.cwiseMax(calibrated.result().residual.cwiseAbs());
+    if (known_torque) {
+      sum_sq_plain += (plain.result().residual - samples[k].truth.tau_ext).cwiseAbs2();
+      sum_sq_cal += (calibrated.result().residual - samples[k].truth.tau_ext).cwiseAbs2();
+    }
+  }
+  if (known_torque && rep.samples > 0) {
+    rep.tracking_rms_uncalibrated = (sum_sq_plain / rep.samples).cwiseSqrt();
+    rep.tracking_rms_calibrated = (sum_sq_cal / rep.samples).cwiseSqrt();
   }
   rep.duration = samples.back().t - samples[first].t;
   // Detectable force along the holdout, with either set of thresholds.

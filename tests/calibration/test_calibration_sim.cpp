@@ -129,6 +129,52 @@ TEST(CalibrationSim, DetectsATenNewtonPushOnEveryLinkWithinFiftyMilliseconds) {
   }
 }
 
+// Calibration in contact (CalibrationOptions::known_external_torque): the same robot pushed on
+// links 2-7 for 45 % of the log, the pushes' τ_ext known (a force plate would give J_vᵀF). With
+// it taken out, the fit recovers the friction as from free motion; without it, the log is
+// refused as not contact-free.
+TEST(CalibrationSim, CalibratesInContactWithAKnownExternalTorque) {
+  const Model model = paper_arm();
+  std::vector<sim::ForceProfile> pushes;
+  for (int link = 2; link <= 7; ++link) {
+    sim::ForceProfile push;
+    push.frame = "link" + std::to_string(link);
+    push.axes = sim::ForceProfile::Axes::kFrame;
+    push.point_F = Vector3(0.1, 0.0, 0.0);
+    push.force = Vector3(0.0, 15.0, 0.0);
+    push.start = 2.0 + 6.0 * (link - 2);
+    push.end = push.start + 3.0;
+    pushes.push_back(push);
+  }
+  const auto log =
+      test::simulate_free_motion(model, test::free_motion(0.0, 1.0), test::paper_arm_friction(),
+                                 40.0, true_bias(), kTauNoise, 17, pushes);
+  EstimatorOptions options;  // no base sensor: its bias would absorb the pushes
+  options.observer_gain = VectorX::Constant(1, 100.0);
+  EXPECT_THROW((void)calibrate(model, options, log), Error);
+  CalibrationOptions in_contact;
+  in_contact.known_external_torque = true;
+  const Calibration cal = calibrate(model, options, log, in_contact);
+  const test::TrueFriction truth = test::paper_arm_friction();
+  for (int i = 0; i < 7; ++i) {
+    SCOPED_TRACE("joint " + std::to_string(i + 1));
+    EXPECT_NEAR(cal.friction.viscous[i], truth.viscous[i], kFrictionTolerance * truth.viscous[i]);
+    EXPECT_NEAR(cal.friction.coulomb[i], truth.coulomb[i], kFrictionTolerance * truth.coulomb[i]);
+    EXPECT_NEAR(cal.friction.offset[i], truth.offset[i], kOffsetTolerance);
+  }
+  EXPECT_TRUE(cal.suspect_windows.empty());
+  // A base sensor is refused with a known torque, and so is a log without true_tau_ext.
+  EXPECT_THROW((void)calibrate(model, ft_options(), log, in_contact), Error);
+  auto without = log;
+  without[5].has_true_tau_ext = false;
+  try {
+    (void)calibrate(model, options, without, in_contact);
+    ADD_FAILURE() << "a sample without true_tau_ext was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("sample 5"), std::string::npos) << e.what();
+  }
+}
+
 // Thresholds that follow the motion, against simulated truth: torque noise that grows with
 // the speed, σ = 0.005 + 0.1 |q̇| N m (as the Panda's measured τ and q̇), is calibrated on the
 // usual motion and judged on motion 1.3 × faster (docs/calibration.md, limitations). The fit

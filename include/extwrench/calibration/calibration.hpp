@@ -43,6 +43,11 @@ struct CalibrationOptions {
   double contact_min_duration = 0.05;   ///< ... for at least this long [s]
   double max_contact_fraction = 0.2;    ///< more suspected contact than this: refused
   bool payload = false;  ///< identify a payload on the last link (needs a base F/T sensor)
+  /// The samples' true_tau_ext is an external torque known during the recording (a force plate
+  /// or a known load: J_vᵀF), subtracted from the residual before the fit, so a log in contact
+  /// calibrates too (docs/calibration.md#calibrating-in-contact). No base sensor: its bias
+  /// would absorb the contact.
+  bool known_external_torque = false;
 };
 
 /// A payload identified on a link (docs/calibration.md#payload): mass and CoM from the base
@@ -124,7 +129,8 @@ struct Calibration {
   std::vector<std::string> warnings;
 };
 
-/// Calibrates from `samples` (contact-free free motion, q̇ filled, t increasing) with the model
+/// Calibrates from `samples` (contact-free free motion, or with known_external_torque a motion
+/// whose external torque is known; q̇ filled, t increasing) with the model
 /// and the estimator options (observer gain, sensor type and pose, payload). Throws
 /// extwrench::Error on a non-finite sample (its index), fewer samples than parameters, a joint
 /// whose friction the motion does not excite (naming the parameter and the motion that would),

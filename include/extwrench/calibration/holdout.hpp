@@ -36,6 +36,9 @@ struct HoldoutReport {
   /// The same with calibrated_max_residual as thresholds: both sides at the smallest constant
   /// thresholds quiet on these samples, with and without calibration.
   std::vector<double> min_force_calibrated_quiet;
+  /// When the log carries true_tau_ext (simulation, or a force plate: J_vᵀF): RMS of
+  /// r_i − τ_ext,i over the judged samples without and with the calibration (n); else empty.
+  VectorX tracking_rms_uncalibrated, tracking_rms_calibrated;
 };
 
 /// Runs both estimators over all `samples` (the fit window too, so that the residuals are in
