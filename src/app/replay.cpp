@@ -87,6 +87,7 @@ class RowEstimator {
  public:
   RowEstimator(ContactEstimator estimator, int n) : estimator_(std::move(estimator)), n_(n) {
     first_.residual = VectorX::Zero(n);
+    first_.torque_offset = estimator_.result().torque_offset;  // the configured offsets, or none
   }
   /// What every estimate looks like (sizes), for the pipeline's buffers.
   [[nodiscard]] const ContactEstimate& prototype() const { return first_; }
@@ -97,9 +98,11 @@ class RowEstimator {
       return estimator_.result();
     }
     const Status st = estimator_.reset(s);
+    VectorX offset = std::move(first_.torque_offset);
     first_ = ContactEstimate{};
     first_.t = s.t;
     first_.residual = VectorX::Zero(n_);
+    first_.torque_offset = std::move(offset);
     first_.status = st;
     started_ = st.ok();
     return first_;
@@ -212,7 +215,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   outputs.create_directories(o.out_dir);
   RowEstimator estimator(ContactEstimator(model, geometry, estimator_options), model.nq());
   const std::filesystem::path estimates = o.out_dir / "estimates.csv";
-  EstimatesWriter writer(outputs.stage(estimates), model);
+  EstimatesWriter writer(outputs.stage(estimates), model, estimator_options.drift.has_value());
   WindowMetrics metrics(o.windows);
   std::optional<detail::FigureRecorder> figures;
   if (o.figures) figures.emplace(model, layout.truth, o.plot_points, o.desired_trajectory);

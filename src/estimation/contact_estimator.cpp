@@ -69,6 +69,16 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   dforce_dddq_.setZero(3, n_);
   minv_jvt_.setZero(n_, 3);
   out_.residual = VectorX::Zero(n_);
+  if (options_.drift) {
+    JointFriction friction = observer_.friction();
+    if (friction.offset.size() != n_) {
+      friction.offset = VectorX::Zero(n_);
+      observer_.set_friction(friction);
+    }
+    initial_offset_ = friction.offset;
+    drift_delta_ = VectorX::Zero(n_);
+    out_.torque_offset = initial_offset_;
+  }
 }
 
 Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
@@ -91,6 +101,13 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
     tare_.request(options_.sensor.tare_samples);
   }
   out_.residual.setZero();
+  if (options_.drift) {  // back to the configured offsets and bias, as a fresh estimator
+    drift_delta_ = initial_offset_ - observer_.friction().offset;
+    observer_.shift_offset(drift_delta_);
+    if (options_.sensor.tare_samples == 0) tare_.bias_S = options_.sensor.bias_S;
+    drift_quiet_since_ = t;
+    drift_t_prev_ = t;
+  }
   return s;
 }
 
@@ -126,9 +143,11 @@ Status ContactEstimator::validate_sample(double t, const Eigen::Ref<const Vector
 
 void ContactEstimator::fail(double t, Status s) noexcept {
   // Outputs only: no state is touched, so the next good sample continues as if this one never came.
-  VectorX residual = std::move(out_.residual);  // keeps the buffer (no allocation)
+  VectorX residual = std::move(out_.residual);  // keeps the buffers (no allocation)
+  VectorX offset = std::move(out_.torque_offset);
   out_ = ContactEstimate{};
   out_.residual = std::move(residual);
+  out_.torque_offset = std::move(offset);
   out_.residual.setConstant(kNaN);
   out_.t = t;
   out_.status = s;
@@ -299,9 +318,11 @@ Status ContactEstimator::update_with(double t, const Eigen::Ref<const VectorX>& 
 
 void ContactEstimator::begin_output(double t) noexcept {
   const Status status = out_.status;
-  VectorX residual = std::move(out_.residual);  // fresh output, keeping the residual buffer
+  VectorX residual = std::move(out_.residual);  // fresh output, keeping the buffers
+  VectorX offset = std::move(out_.torque_offset);
   out_ = ContactEstimate{};
   out_.residual = std::move(residual);
+  out_.torque_offset = std::move(offset);
   out_.status = status;
   out_.t = t;
   out_.residual = tau_ext_;
@@ -326,6 +347,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   const DetectionResult& det = detector_.update(t, tau_ext_, base_force, release_force);
   out_.contact = det.contact;
   flags |= detection_flags(det);
+  if (options_.drift) track_drift(t, det, base);
   // 7. Isolation.
   int link = isolate(det, options_.contact.model, options_.contact.link, flags);
   if (link >= 0 && isolation_rule_ == IsolationRule::kGeometry &&
@@ -350,6 +372,40 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   consistency(t, link, det.contact, fit, flags);
   release_point_L_ = out_.point_L.allFinite() ? out_.point_L : Vector3::Zero();
   out_.flags = flags;
+}
+
+// Drift tracking (after detection): while no contact is declared, pending or raw, and one
+// settling time after the last such sample, the offsets o_i follow −r_i (r ≈ τ_ext + o_true − o)
+// and the bias follows F̂_ext and n_m − ñ_g in S, as first-order filters of time constant T
+// with each step bounded by its rate × Δt. In: det, base (stage 5), observer_.residual().
+// Out: the observer's offsets, tare_.bias_S, out_.torque_offset, out_.sensor_bias_S.
+void ContactEstimator::track_drift(double t, const DetectionResult& det,
+                                   const BaseWrench& base) noexcept {
+  const DriftOptions& d = *options_.drift;
+  const double dt = t - drift_t_prev_;
+  drift_t_prev_ = t;
+  const bool busy = det.contact || det.pending || det.raw || base.taring || !out_.status.ok();
+  if (busy) drift_quiet_since_ = t;
+  if (!busy && dt > 0.0 && t - drift_quiet_since_ >= settle_time_) {
+    const double a = dt / (d.time_constant + dt);  // backward-Euler first-order filter
+    const double max_torque = d.max_torque_rate * dt;
+    drift_delta_ = (-a * observer_.residual()).cwiseMax(-max_torque).cwiseMin(max_torque);
+    observer_.shift_offset(drift_delta_);
+    if (options_.sensor.type != SensorType::kNone) {
+      const Matrix3& R_WS = options_.sensor.X_WS.rotation;
+      const double max_force = d.max_force_rate * dt;
+      const Vector3 force_S = R_WS.transpose() * base.force_W;
+      tare_.bias_S.head<3>() += (a * force_S).cwiseMax(-max_force).cwiseMin(max_force);
+      if (options_.sensor.type == SensorType::kForceTorque) {
+        const double max_moment = d.max_moment_rate * dt;
+        const Vector3 moment_S = R_WS.transpose() * base.dn_W;
+        tare_.bias_S.tail<3>() += (a * moment_S).cwiseMax(-max_moment).cwiseMin(max_moment);
+      }
+    }
+  }
+  out_.torque_offset = observer_.friction().offset;
+  if (options_.sensor.type != SensorType::kNone) out_.sensor_bias_S = tare_.bias_S;
+  if (options_.sensor.type == SensorType::kForce) out_.sensor_bias_S.tail<3>().setConstant(kNaN);
 }
 
 // 5. In: the reading [f; n] in S, data_.root_wrench_W of stage 4. Out: F̂_ext (11) and

@@ -44,6 +44,16 @@ void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   if (!(o.isolation.ambiguity_distance >= 0.0) || !std::isfinite(o.isolation.ambiguity_distance)) {
     throw Error(where + ": isolation.ambiguity_distance: expected a finite value >= 0 [m]");
   }
+  if (o.drift) {
+    const auto positive = [&](double v, const char* name) {
+      if (!(v > 0.0) || !std::isfinite(v))
+        throw Error(where + ": drift." + name + ": expected a finite value > 0");
+    };
+    positive(o.drift->time_constant, "time_constant");
+    positive(o.drift->max_torque_rate, "max_torque_rate");
+    positive(o.drift->max_force_rate, "max_force_rate");
+    positive(o.drift->max_moment_rate, "max_moment_rate");
+  }
 }
 
 }  // namespace

@@ -206,6 +206,24 @@ void read_isolation(const YamlReader& rd, const YAML::Node& node, IsolationOptio
                    o.ambiguity_distance);
 }
 
+// drift: true | false, or {time_constant, max_torque_rate, max_force_rate, max_moment_rate}.
+void read_drift(const YamlReader& rd, const YAML::Node& node, std::optional<DriftOptions>& o) {
+  if (YamlReader::is_boolean(node)) {
+    if (rd.boolean(node, "drift")) o = DriftOptions{};
+    return;
+  }
+  rd.only_keys(node, "drift",
+               {"time_constant", "max_torque_rate", "max_force_rate", "max_moment_rate"});
+  DriftOptions d;
+  rd.set_number_in(node, "drift", "time_constant", {0, 1e9, true, "> 0 [s]"}, d.time_constant);
+  rd.set_number_in(node, "drift", "max_torque_rate", {0, 1e9, true, "> 0 [N m/s]"},
+                   d.max_torque_rate);
+  rd.set_number_in(node, "drift", "max_force_rate", {0, 1e9, true, "> 0 [N/s]"}, d.max_force_rate);
+  rd.set_number_in(node, "drift", "max_moment_rate", {0, 1e9, true, "> 0 [N m/s]"},
+                   d.max_moment_rate);
+  o = d;
+}
+
 void read_solver(const YamlReader& rd, const YAML::Node& s, SolverOptions& o) {
   rd.only_keys(s, "solver", {"max_condition", "rank_tolerance"});
   rd.set_number_in(s, "solver", "max_condition", {1, 1e300, true, "> 1"}, o.max_condition);
@@ -235,10 +253,10 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
                           const LoadOptions& robot_options) {
   const YamlReader rd(source.string());
   if (!root.IsDefined() || root.IsNull()) rd.fail(root, "(top level)", "empty configuration");
-  rd.only_keys(
-      root, "",
-      {"robot", "locked_joints", "gravity", "sensor", "contact", "observer", "detection",
-       "acceleration", "friction", "armature", "payload", "solver", "isolation", "calibration"});
+  rd.only_keys(root, "",
+               {"robot", "locked_joints", "gravity", "sensor", "contact", "observer", "detection",
+                "acceleration", "friction", "armature", "payload", "solver", "isolation",
+                "calibration", "drift"});
   EstimatorConfig cfg;
   cfg.source = source;
   read_robot(rd, root, source, robot_options, cfg);
@@ -265,6 +283,7 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (root["payload"]) read_payload(rd, root["payload"], model, o);
   if (root["solver"]) read_solver(rd, root["solver"], o.solver);
   if (root["isolation"]) read_isolation(rd, root["isolation"], o.isolation);
+  if (root["drift"]) read_drift(rd, root["drift"], o.drift);
   if (root["calibration"]) read_calibration(rd, root, source, n, o);
 
   // The remaining checks need the whole picture (serial chain, sizes).
@@ -385,6 +404,12 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
     if (iso.rule) y << "rule: " << to_string(*iso.rule) << ", ";
     y << "tolerance: " << iso.tolerance << ", ambiguity_distance: " << iso.ambiguity_distance
       << "}\n";
+  }
+  if (o.drift) {
+    y << "drift: {time_constant: " << o.drift->time_constant
+      << ", max_torque_rate: " << o.drift->max_torque_rate
+      << ", max_force_rate: " << o.drift->max_force_rate
+      << ", max_moment_rate: " << o.drift->max_moment_rate << "}\n";
   }
   return y.str();
 }

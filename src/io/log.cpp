@@ -247,18 +247,25 @@ void LogWriter::write(const Sample& s) {
 }
 
 namespace {
-std::vector<std::string> estimates_columns(int n) {
+std::vector<std::string> estimates_columns(int n, bool drift) {
   std::vector<std::string> c{"t",  "contact", "link", "fx", "fy", "fz", "mx",     "my",  "mz",
                              "px", "py",      "pz",   "lx", "ly", "lz", "status", "cond"};
   for (const auto& r : numbered("r", n)) c.push_back(r);
   c.push_back("link_candidates");  // issue 9: appended, so the older columns keep their places
+  if (drift) {                     // only with drift tracking on (EstimatorOptions::drift)
+    for (const auto& o : numbered("offset", n)) c.push_back(o);
+    for (const char* b : {"bias_fx", "bias_fy", "bias_fz", "bias_mx", "bias_my", "bias_mz"})
+      c.push_back(b);
+  }
   return c;
 }
 }  // namespace
 
-EstimatesWriter::EstimatesWriter(const std::filesystem::path& path, const Model& model)
+EstimatesWriter::EstimatesWriter(const std::filesystem::path& path, const Model& model,
+                                 bool drift_columns)
     : n_(model.nq()),
-      csv_(path, estimates_columns(model.nq())),
+      drift_columns_(drift_columns),
+      csv_(path, estimates_columns(model.nq(), drift_columns)),
       cached_status_(describe_flags(cached_flags_)) {
   for (const Body& b : model.bodies) body_names_.push_back(b.name);
 }
@@ -317,6 +324,11 @@ void EstimatesWriter::write(const ContactEstimate& e) {
     csv_.add(e.residual.size() == n_ ? e.residual[i] : std::nan(""));
   }
   write_candidates(e.link_candidates);
+  if (drift_columns_) {
+    for (int i = 0; i < n_; ++i)
+      csv_.add(e.torque_offset.size() == n_ ? e.torque_offset[i] : std::nan(""));
+    for (int k = 0; k < 6; ++k) csv_.add(e.sensor_bias_S[k]);
+  }
   csv_.end_row();
 }
 

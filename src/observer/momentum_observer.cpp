@@ -60,6 +60,15 @@ void MomentumObserver::set_friction(const JointFriction& friction) {
   }
 }
 
+void MomentumObserver::shift_offset(const Eigen::Ref<const VectorX>& delta) noexcept {
+  friction_.offset += delta;
+  if (initialized_) {
+    // τ_f(q̇) grows by δ: γ = Cᵀq̇ − g − τ_f of the last sample drops by it (see set_friction).
+    tau_f_ += delta;
+    gamma_prev_ -= delta;
+  }
+}
+
 void MomentumObserver::integrand(const Data& data, const Eigen::Ref<const VectorX>& dq) noexcept {
   extwrench::friction_torque(friction_, dq, tau_f_);
   // γ = Cᵀq̇ − g − τ_f: the state-dependent part of the integrand of (4).

@@ -234,9 +234,13 @@ TEST(CalibratedEstimator, UpdateAllocatesNothing) {
                                  3.0, Vector6::Zero(), 0.02, 3);
   CalibrationOptions speed;
   speed.thresholds = ThresholdModel::kSpeed;  // thresholds a + b|q̇| on every joint
-  for (const CalibrationOptions& co : {CalibrationOptions{}, speed}) {
-    const Calibration cal = calibrate(model, options, log, co);
-    ContactEstimator est(model, GeometryModel{}, apply_calibration(options, cal));
+  // Constant thresholds, thresholds a + b|q̇|, and constant ones with drift tracking on.
+  for (int variant = 0; variant < 3; ++variant) {
+    const Calibration cal =
+        calibrate(model, options, log, variant == 1 ? speed : CalibrationOptions{});
+    EstimatorOptions calibrated = apply_calibration(options, cal);
+    if (variant == 2) calibrated.drift = DriftOptions{};
+    ContactEstimator est(model, GeometryModel{}, calibrated);
     ASSERT_TRUE(est.reset(log.front()).ok());
     const test::AllocationCounter counter;
     for (std::size_t k = 1; k < log.size(); ++k) (void)est.update(log[k]);

@@ -201,7 +201,34 @@ INSTANTIATE_TEST_SUITE_P(
             ":3:", "payload.inertia", "payload"},
         BadConfig{"sensor: {type: ft}\nsolver: {max_condition: 0.5}\n",
                   ":3:", "solver.max_condition", "> 1"},
+        BadConfig{"sensor: {type: ft}\ndrift: {time_constant: 0}\n", ":3:", "drift.time_constant",
+                  "> 0"},
+        BadConfig{"sensor: {type: ft}\ndrift: {max_rate: 1}\n", ":3:", "drift.max_rate",
+                  "unknown key"},
         BadConfig{"sensor: [ft\n", ":", "YAML", "syntax"}));
+
+// drift: true takes the defaults; a mapping sets them; to_yaml writes them back; absent = off.
+TEST(EstimatorConfig, DriftTrackingIsOptInAndRoundTrips) {
+  const std::string robot = "robot: ../../../models/paper_arm.urdf\nsensor: {type: ft}\n";
+  EXPECT_FALSE(load_estimator_config_string(robot, kDir / "a.yaml").options.drift);
+  const EstimatorConfig on = load_estimator_config_string(robot + "drift: true\n", kDir / "b.yaml");
+  ASSERT_TRUE(on.options.drift);
+  EXPECT_EQ(on.options.drift->time_constant, DriftOptions{}.time_constant);
+  const EstimatorConfig set = load_estimator_config_string(
+      robot +
+          "drift: {time_constant: 12, max_torque_rate: 0.2, max_force_rate: 0.3, "
+          "max_moment_rate: 0.04}\n",
+      kDir / "c.yaml");
+  ASSERT_TRUE(set.options.drift);
+  const EstimatorConfig back = load_estimator_config_string(to_yaml(set, kDir), kDir / "d.yaml");
+  ASSERT_TRUE(back.options.drift);
+  EXPECT_EQ(back.options.drift->time_constant, 12.0);
+  EXPECT_EQ(back.options.drift->max_torque_rate, 0.2);
+  EXPECT_EQ(back.options.drift->max_force_rate, 0.3);
+  EXPECT_EQ(back.options.drift->max_moment_rate, 0.04);
+  EXPECT_FALSE(
+      load_estimator_config_string(robot + "drift: false\n", kDir / "e.yaml").options.drift);
+}
 
 TEST(EstimatorConfig, MissingRobotOrRobotFileIsAnErrorNamingTheKey) {
   try {

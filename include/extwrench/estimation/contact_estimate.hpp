@@ -94,6 +94,10 @@ struct ContactEstimate {
   Eigen::Matrix<double, 6, 6> observable_basis_W = Eigen::Matrix<double, 6, 6>::Zero();
   int observable_rank = -1;  ///< dimension of that subspace; −1 when not partial
   VectorX residual;  ///< τ̂_ext (n) used for isolation: r, or RNEA − τ (differentiation route)
+  /// Drift tracking (EstimatorOptions::drift): the joint torque offsets o_i in use (n) and the
+  /// sensor bias [f; n] in S after this sample; size 0 / NaN without drift tracking.
+  VectorX torque_offset;
+  Vector6 sensor_bias_S = Vector6::Constant(kNaN);
   double condition_number =
       kNaN;       ///< σ_max/σ_min of the Jacobian inverted (cases D, E), SI units; NaN when none
   Status status;  ///< input errors; ok otherwise

@@ -116,6 +116,7 @@ class ContactEstimator {
   void contact_point(int link, const WrenchFit& fit, bool contact, std::uint32_t& flags) noexcept;
   void consistency(double t, int link, bool contact, const WrenchFit& fit,
                    std::uint32_t& flags) noexcept;
+  void track_drift(double t, const DetectionResult& det, const BaseWrench& base) noexcept;
 
   Status validate_sample(double t, const Eigen::Ref<const VectorX>& q,
                          const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau,
@@ -149,6 +150,9 @@ class ContactEstimator {
   double disagreement_edge_ = 0.0;
   int release_link_ = -1;  ///< contact link of the last sample (−1: none), for the release
   Vector3 release_point_L_ = Vector3::Zero();  ///< its contact point (link frame), else O_l
+  VectorX initial_offset_, drift_delta_;       ///< drift tracking: configured offsets, one step
+  double drift_quiet_since_ = 0.0;             ///< last sample with contact, pending or raw [s]
+  double drift_t_prev_ = 0.0;
   SpectrumGuess spectrum_;  ///< of J Jᵀ at the last damped solve (cases D, E); size 0 after reset
 
   // Scratch, sized once.

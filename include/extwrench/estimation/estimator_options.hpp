@@ -34,6 +34,17 @@ struct PayloadOptions {
   Inertia inertia;  ///< mass properties in that body's frame
 };
 
+/// Slow drift tracking (docs/estimator.md#drift-tracking): while no contact is declared (and the
+/// residual has settled since the last one), the joint torque offsets and the base sensor's bias
+/// follow what is left in the residual and in F̂_ext, as first-order filters of time constant
+/// `time_constant`, each entry moving at most at its rate; frozen during contact.
+struct DriftOptions {
+  double time_constant = 30.0;     ///< [s] > 0
+  double max_torque_rate = 0.01;   ///< [N m/s] (N/s prismatic) > 0, per joint offset
+  double max_force_rate = 0.05;    ///< [N/s] > 0, per sensor force axis
+  double max_moment_rate = 0.005;  ///< [N m/s] > 0, per sensor moment axis
+};
+
 struct EstimatorOptions {
   SensorOptions sensor;
   ContactOptions contact;
@@ -45,6 +56,7 @@ struct EstimatorOptions {
   std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction
   std::optional<PayloadOptions> payload;
   SolverOptions solver;
+  std::optional<DriftOptions> drift;  ///< opt-in; none: offsets and bias stay as configured
 };
 
 /// Throws extwrench::Error if the options do not fit the model (sizes, link indices, ranges,

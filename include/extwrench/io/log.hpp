@@ -86,13 +86,16 @@ class LogWriter {
 };
 
 /// The estimates file: t, contact, link, fx fy fz, mx my mz, px py pz, lx ly lz, status, cond,
-/// r1..rn, link_candidates (world frame; quantities not estimated are empty cells; round-trip
+/// r1..rn, link_candidates [, offset1..n, bias_fx..bias_mz with drift tracking] (world frame;
+/// quantities not estimated are empty cells; round-trip
 /// precision). link_candidates: the other links geometry isolation found consistent, by name,
 /// '|'-separated (docs/estimator.md#geometry-consistent-isolation).
 class EstimatesWriter {
  public:
-  /// `model` gives n and the body names of the link column.
-  EstimatesWriter(const std::filesystem::path& path, const Model& model);
+  /// `model` gives n and the body names of the link column. `drift_columns`: append
+  /// offset1..n and bias_fx..bias_mz (the estimator's drift tracking, EstimatorOptions::drift).
+  EstimatesWriter(const std::filesystem::path& path, const Model& model,
+                  bool drift_columns = false);
   void write(const ContactEstimate& e);
   void close() { csv_.close(); }
 
@@ -102,6 +105,7 @@ class EstimatesWriter {
 
  private:
   int n_;
+  bool drift_columns_ = false;
   std::vector<std::string> body_names_;
   CsvWriter csv_;
   // The status text of the last ok row: flags change rarely, describe_flags() allocates.

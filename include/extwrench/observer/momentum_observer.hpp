@@ -47,6 +47,10 @@ class MomentumObserver {
   /// Throws extwrench::Error on bad sizes. Once initialized, the integrand of the current
   /// interval is corrected to the new friction at the last q̇.
   void set_friction(const JointFriction& friction);
+  /// Adds `delta` (n) to the friction's torque offsets o_i (drift tracking): allocation-free,
+  /// the current interval's integrand corrected like set_friction. Needs friction().offset of
+  /// size n (set_friction with an offset first).
+  void shift_offset(const Eigen::Ref<const VectorX>& delta) noexcept;
 
   /// Starts (or restarts) the observer at time t: r = 0, m(0) = B(q) q̇ (momentum_terms on
   /// `data`). The torque of the interval [t, t_1) is `tau`; the overload without it takes the
