@@ -89,5 +89,28 @@ TEST(CalibrationTeststand, KneeResidualTracksTheForcePlateAfterCalibrationInCont
       knee_before, knee_after, force_before, force_after, judged);
 }
 
+// The same log calibrated as if it were free (no --known-torque): the contact covers 86 % of
+// it, too much for the suspect windows (their robust spread is the contact's own), so the
+// calibration must warn that the model leaves most of the knee torque unexplained.
+TEST(CalibrationTeststand, ALogInContactThroughoutIsWarnedAbout) {
+  if (!fs::exists(teststand_dir() / "log.csv")) GTEST_SKIP() << "no " << teststand_dir();
+  const EstimatorConfig cfg = teststand_config();
+  std::vector<Sample> samples;
+  LogReader reader(teststand_dir() / "log.csv", cfg.robot.model);
+  for (Sample s; reader.next(s);) samples.push_back(s);
+  const Calibration cal = calibrate(cfg.robot.model, cfg.options, samples);
+  bool knee = false;
+  for (const std::string& w : cal.warnings)
+    knee = knee || (w.find("joint 2") != std::string::npos &&
+                    w.find("explains little") != std::string::npos &&
+                    w.find("[0.000000, 23.371000] s") != std::string::npos);
+  EXPECT_TRUE(knee) << "no warning about joint 2 among " << cal.warnings.size();
+  // In contact with the torque known, nothing is left unexplained.
+  CalibrationOptions in_contact;
+  in_contact.known_external_torque = true;
+  for (const std::string& w : calibrate(cfg.robot.model, cfg.options, samples, in_contact).warnings)
+    EXPECT_EQ(w.find("explains little"), std::string::npos) << w;
+}
+
 }  // namespace
 }  // namespace extwrench
