@@ -200,25 +200,22 @@ void joint_threshold(const std::vector<double>& r, const std::vector<Sample>& sa
 void speed_threshold(const std::vector<double>& r, const std::vector<double>& dq,
                      const std::vector<Sample>& samples, const std::vector<char>& use, double rate,
                      double margin, JointFitReport& j) {
-  double s1 = 0, sv = 0, svv = 0, se = 0, sve = 0;
+  std::vector<double> speed(r.size()), size(r.size());
   for (std::size_t k = 0; k < r.size(); ++k) {
-    if (!use[k]) continue;
-    const double v = std::abs(dq[k]), e = std::abs(r[k]);
-    s1 += 1;
-    sv += v;
-    svv += v * v;
-    se += e;
-    sve += v * e;
+    speed[k] = std::abs(dq[k]);
+    size[k] = std::abs(r[k]);
   }
-  const double mean_e = se / s1;
-  const double det = s1 * svv - sv * sv;
-  double e1 = det > 1e-12 * s1 * svv ? (s1 * sve - sv * se) / det : 0.0;
-  double e0 = (se - e1 * sv) / s1;
+  const calibration_detail::LineFit line = calibration_detail::fit_line(speed, size, use);
+  const double s1 = line.count, mean_e = line.mean_y;
+  double e1 = line.slope, e0 = line.intercept;
   if (e1 <= 0.0) {
     e1 = 0.0;
     e0 = mean_e;
   } else if (e0 < 0.25 * mean_e) {
+    // Intercept held at e0: the slope through it, Σ v (e − e0) / Σ v², from the centred sums.
     e0 = 0.25 * mean_e;
+    const double sv = s1 * line.mean_x, svv = line.sxx + s1 * line.mean_x * line.mean_x;
+    const double sve = line.sxy + s1 * line.mean_x * line.mean_y;
     e1 = svv > 0 ? std::max((sve - e0 * sv) / svv, 0.0) : 0.0;
   }
   const double c = std::sqrt(std::acos(-1.0) / 2.0);

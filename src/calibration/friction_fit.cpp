@@ -62,6 +62,34 @@ Solve solve(const std::array<const std::vector<double>*, 3>& z, const std::vecto
 
 }  // namespace
 
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
+                 const std::vector<char>& use) {
+  LineFit f;
+  double sx = 0.0, sy = 0.0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    if (!use[k]) continue;
+    f.count += 1.0;
+    sx += x[k];
+    sy += y[k];
+  }
+  if (f.count < 1.0) return f;
+  f.mean_x = sx / f.count;
+  f.mean_y = sy / f.count;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    if (!use[k]) continue;
+    const double dx = x[k] - f.mean_x, dy = y[k] - f.mean_y;
+    f.sxx += dx * dx;
+    f.sxy += dx * dy;
+    f.syy += dy * dy;
+  }
+  f.intercept = f.mean_y;
+  if (f.count < 3.0 || f.sxx <= 1e-300) return f;
+  f.slope = f.sxy / f.sxx;
+  f.intercept = f.mean_y - f.slope * f.mean_x;
+  if (f.syy > 1e-300) f.r2 = f.sxy * f.sxy / (f.sxx * f.syy);
+  return f;
+}
+
 void filter_regressor(const std::vector<double>& phi, const std::vector<double>& alpha,
                       std::vector<double>& z) {
   z.assign(phi.size(), 0.0);

@@ -23,6 +23,16 @@ struct JointFrictionFit {
   std::vector<std::string> warnings;
 };
 
+/// The least-squares line y ≈ intercept + slope x over the samples with use[k] != 0 (centred
+/// sums). r2 = 0 and slope = 0 when fewer than 3 samples or x or y is constant.
+struct LineFit {
+  double count = 0.0, mean_x = 0.0, mean_y = 0.0;
+  double sxx = 0.0, sxy = 0.0, syy = 0.0;  ///< centred sums of squares and products
+  double slope = 0.0, intercept = 0.0, r2 = 0.0;
+};
+[[nodiscard]] LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
+                               const std::vector<char>& use);
+
 /// The observer's filter of a regressor: z_k = α_k z_{k−1} + (1 − α_k) ½ (φ_{k−1} + φ_k), z_0 = 0.
 void filter_regressor(const std::vector<double>& phi, const std::vector<double>& alpha,
                       std::vector<double>& z);

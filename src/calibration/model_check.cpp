@@ -20,32 +20,6 @@ std::string num(double x) {
   return b;
 }
 
-// R² and slope of y on [1, x] over the used samples.
-struct Line {
-  double r2 = 0.0, slope = 0.0;
-};
-Line line_fit(const std::vector<double>& y, const std::vector<double>& x,
-              const std::vector<char>& use) {
-  double n = 0, sx = 0, sy = 0;
-  for (std::size_t k = 0; k < y.size(); ++k) {
-    if (!use[k]) continue;
-    n += 1;
-    sx += x[k];
-    sy += y[k];
-  }
-  if (n < 3) return {};
-  const double mx = sx / n, my = sy / n;
-  double sxx = 0, sxy = 0, syy = 0;
-  for (std::size_t k = 0; k < y.size(); ++k) {
-    if (!use[k]) continue;
-    sxx += (x[k] - mx) * (x[k] - mx);
-    sxy += (x[k] - mx) * (y[k] - my);
-    syy += (y[k] - my) * (y[k] - my);
-  }
-  if (sxx <= 1e-300 || syy <= 1e-300) return {};
-  return {sxy * sxy / (sxx * syy), sxy / sxx};
-}
-
 }  // namespace
 
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
@@ -70,7 +44,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     for (std::size_t k = 0; k < s.dq.size(); ++k)
       phi[k] = s.dq[k] > 0 ? 1.0 : (s.dq[k] < 0 ? -1.0 : 0.0);
     filter_regressor(phi, s.alpha, z);
-    const Line coulomb = line_fit(before[i].r0, z, use);
+    const LineFit coulomb = fit_line(z, before[i].r0, use);
     if (coulomb.r2 >= kJointShare) {
       check.patterns.push_back({"coulomb", joint, coulomb.r2,
                                 "joint " + std::to_string(joint) +
@@ -80,7 +54,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     }
     // Follows g(q): the calibrated residual against the filtered gravity torque.
     filter_regressor(gravity[i], s.alpha, z);
-    const Line g = line_fit(after[i].residual, z, use);
+    const LineFit g = fit_line(z, after[i].residual, use);
     if (g.r2 >= kJointShare) {
       check.patterns.push_back(
           {"gravity", joint, g.r2,
