@@ -56,19 +56,6 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // Keys sit outside the plot area, on the right, so that they never hide a curve or a title.
 constexpr const char* kKey = "set key outside right top vertical samplen 2\n";
 
-void write_script(const std::filesystem::path& path, const std::string& text,
-                  OutputFiles& outputs) {
-  const std::filesystem::path partial = outputs.stage(path);
-  {
-    std::ofstream out(partial);
-    if (!out) throw Error(partial.string() + ": cannot create the file");
-    out << text;
-    out.flush();
-    if (!out) throw Error(partial.string() + ": write failed (disk full?)");
-  }
-  outputs.commit(path);
-}
-
 // Fig. 5: joint positions, and the desired ones when the controller's trajectory is known.
 std::string joints_script(const PlotContext& c, const Figure& f) {
   std::ostringstream s;
@@ -309,10 +296,10 @@ DrawnFigures FigureRecorder::draw(const FigureOptions& o, OutputFiles& parent) c
   const PlotContext c = context_of(o, rows_, model_.nq(), truth_);
   std::vector<Figure> figures{figure(c, "joints"), figure(c, "force"), figure(c, "line_point"),
                               figure(c, "condition")};
-  write_script(figures[0].script, joints_script(c, figures[0]), outputs);
-  write_script(figures[1].script, force_script(c, figures[1]), outputs);
-  write_script(figures[2].script, line_point_script(c, figures[2]), outputs);
-  write_script(figures[3].script, condition_script(c, figures[3], rows_, o.max_condition), outputs);
+  outputs.write_text(figures[0].script, joints_script(c, figures[0]));
+  outputs.write_text(figures[1].script, force_script(c, figures[1]));
+  outputs.write_text(figures[2].script, line_point_script(c, figures[2]));
+  outputs.write_text(figures[3].script, condition_script(c, figures[3], rows_, o.max_condition));
   const Robot3dInput in{model_, o.geometry, snapshot_rows_, o.snapshots, o.p_WS, truth_};
   figures.push_back(plot_robot3d(c, in, outputs));
   for (const Figure& f : figures) (void)outputs.stage(f.output);  // gnuplot draws to .partial

@@ -56,15 +56,7 @@ std::vector<EstimatorConfig> write_scheme_configs(const Scenario& s,
   for (const SchemeSpec& scheme : s.schemes) {
     outputs.create_directories(dir / scheme.name);
     const std::filesystem::path cfg = dir / scheme.name / "config.yaml";
-    {
-      const std::filesystem::path partial = outputs.stage(cfg);
-      std::ofstream out(partial);
-      if (!out) throw Error(partial.string() + ": cannot create the file");
-      out << scheme_config_yaml(s, scheme);
-      out.flush();
-      if (!out) throw Error(partial.string() + ": write failed (disk full?)");
-    }
-    outputs.commit(cfg);
+    outputs.write_text(cfg, scheme_config_yaml(s, scheme));
     try {
       configs.push_back(load_estimator_config(cfg));
     } catch (const Error& e) {
@@ -218,9 +210,7 @@ GeometryModel geometry_with_mesh_files(const GeometryModel& geometry,
       outputs.create_directories(dir / "meshes");
       const std::filesystem::path file = dir / "meshes" / (name + ".obj");
       {
-        const std::filesystem::path partial = outputs.stage(file);
-        std::ofstream obj(partial);
-        if (!obj) throw Error(partial.string() + ": cannot create the file");
+        std::ostringstream obj;
         obj << "# " << shape.mesh->path << " (written by extwrench simulate)\n";
         const auto& v = shape.mesh->vertices;
         for (Eigen::Index i = 0; i < v.cols(); ++i) {
@@ -230,10 +220,8 @@ GeometryModel geometry_with_mesh_files(const GeometryModel& geometry,
         const auto& f = shape.mesh->triangles;
         for (Eigen::Index i = 0; i < f.cols(); ++i)
           obj << "f " << f(0, i) + 1 << ' ' << f(1, i) + 1 << ' ' << f(2, i) + 1 << '\n';
-        obj.flush();
-        if (!obj) throw Error(partial.string() + ": write failed (disk full?)");
+        outputs.write_text(file, obj.view());
       }
-      outputs.commit(file);
       auto copy = std::make_shared<TriangleMesh>(*shape.mesh);
       copy->path = std::filesystem::absolute(file).string();
       file_mesh = std::move(copy);

@@ -38,16 +38,6 @@ double target_metric(const ReplayResult& replay, const std::string& metric) {
 namespace detail {
 namespace {
 
-void write_text(const std::filesystem::path& path, const std::string& text, OutputFiles& outputs) {
-  {
-    std::ofstream out(outputs.stage(path));
-    out << text;
-    out.flush();
-    if (!out) throw Error(path.string() + ": write failed (disk full?)");
-  }
-  outputs.commit(path);
-}
-
 // One block per scheme: "seed force_rms force_rms_outside line_rms", NaN when absent.
 std::string summary_data(const Scenario& s, const std::vector<SeedResult>& results) {
   std::ostringstream d;
@@ -150,8 +140,8 @@ std::optional<std::filesystem::path> draw_summary(const Scenario& s,
   const Figure f = figure(c, "summary");
   OutputFiles outputs;  // its own transaction: a failure leaves the run's other files alone
   try {
-    write_text(dir / "summary.txt", summary_data(s, results), outputs);
-    write_text(f.script, summary_script(s, f, format), outputs);
+    outputs.write_text(dir / "summary.txt", summary_data(s, results));
+    outputs.write_text(f.script, summary_script(s, f, format));
     (void)outputs.stage(f.output);
     run_gnuplot(f.script, OutputFiles::partial_name(f.output));
     outputs.commit(f.output);

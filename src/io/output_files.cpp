@@ -1,6 +1,7 @@
 #include "extwrench/io/output_files.hpp"
 
 #include <algorithm>
+#include <fstream>
 #include <system_error>
 
 #include "extwrench/core/error.hpp"
@@ -34,6 +35,18 @@ fs::path OutputFiles::partial_name(const fs::path& path) {
   fs::path p = path;
   p += ".partial";
   return p;
+}
+
+void OutputFiles::write_text(const fs::path& path, std::string_view text) {
+  const fs::path partial = stage(path);
+  {
+    std::ofstream out(partial);
+    if (!out) throw Error(partial.string() + ": cannot create the file");
+    out << text;
+    out.flush();
+    if (!out) throw Error(partial.string() + ": write failed (disk full?)");
+  }
+  commit(path);
 }
 
 fs::path OutputFiles::stage(const fs::path& path) {

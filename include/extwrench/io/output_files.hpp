@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 namespace extwrench {
@@ -27,6 +28,9 @@ class OutputFiles {
   /// The staged file of `path` is not wanted (a figure that failed): removes "<path>.partial"
   /// now; the rest of the transaction is unaffected.
   void discard(const std::filesystem::path& path);
+  /// stage(path), the text written, flushed and checked, commit(path): a small text file in one
+  /// call. Throws extwrench::Error naming the file when it cannot be created or written.
+  void write_text(const std::filesystem::path& path, std::string_view text);
   /// Registers a file written directly under its name (figures), to remove on rollback.
   void adopt(const std::filesystem::path& path);
   /// The files committed or adopted so far (to hand a nested transaction's files to its parent).
