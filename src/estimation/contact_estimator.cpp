@@ -429,7 +429,7 @@ int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& b
   in.sensor = options_.sensor.type;
   in.residual_link = residual_link;
   in.tau_ext = &tau_ext_;
-  in.tau_min = &detector_.tau_min();
+  in.tau_min = &detector_.thresholds();
   in.base = &base;
   in.p_WS = options_.sensor.X_WS.translation;
   const IsolationResult r = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
@@ -526,7 +526,7 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
 void ContactEstimator::consistency(double t, int link, bool contact, const WrenchFit& fit,
                                    std::uint32_t& flags) noexcept {
   const bool inconsistent = contact && fit.ok && !fit.damped && link > 0 &&
-                            contradicts_residual(J_, fit, tau_ext_, detector_.tau_min(), tau_pred_);
+                            contradicts_residual(J_, fit, tau_ext_, detector_.thresholds(), tau_pred_);
   if (inconsistent) {
     if (!have_disagreement_edge_) {
       have_disagreement_edge_ = true;

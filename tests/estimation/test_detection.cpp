@@ -84,7 +84,7 @@ TEST(Detection, SpeedThresholdsRiseWithTheJointSpeed) {
   VectorX dq = VectorX::Zero(kJoints);
   dq[1] = -0.5;  // threshold 2 N m on joint 2
   detector.set_motion(dq);
-  EXPECT_DOUBLE_EQ(detector.tau_min()[1], 2.0);
+  EXPECT_DOUBLE_EQ(detector.thresholds()[1], 2.0);
   EXPECT_DOUBLE_EQ(detector.tau_min()[0], 1.0);
   EXPECT_FALSE(detector.update(0.0, tau_ext, NAN).raw);
   dq[1] = 0.1;  // threshold 1.2 N m

@@ -72,7 +72,10 @@ class ContactDetector {
                                 double release_force_norm = kNoReleaseForce) noexcept;
   static constexpr double kNoReleaseForce = std::numeric_limits<double>::quiet_NaN();
   [[nodiscard]] const DetectionResult& result() const noexcept { return result_; }
-  /// The joint thresholds in force (τ_min + b ∘ |q̇| at the last set_motion; τ_min when constant).
+  /// The joint thresholds in force: τ_min + b ∘ |q̇| at the last set_motion (τ_min when constant).
+  [[nodiscard]] const VectorX& thresholds() const noexcept { return threshold_; }
+  /// The same as thresholds() (its name from before the thresholds followed |q̇|; kept for
+  /// compatibility: it returns τ_min + b ∘ |q̇|, not options().tau_min).
   [[nodiscard]] const VectorX& tau_min() const noexcept { return threshold_; }
   /// Whether the thresholds follow |q̇| (tau_per_speed given and not all zero).
   [[nodiscard]] bool speed_dependent() const noexcept { return speed_dependent_; }
