@@ -252,6 +252,7 @@ std::vector<std::string> estimates_columns(int n) {
                              "px", "py",      "pz",   "lx", "ly", "lz", "status", "cond"};
   for (const auto& r : numbered("r", n)) c.push_back(r);
   c.push_back("link_candidates");  // issue 9: appended, so the older columns keep their places
+  for (const char* sigma : {"sigma_f", "sigma_m", "sigma_line", "sigma_point"}) c.push_back(sigma);
   return c;
 }
 }  // namespace
@@ -317,6 +318,10 @@ void EstimatesWriter::write(const ContactEstimate& e) {
     csv_.add(e.residual.size() == n_ ? e.residual[i] : std::nan(""));
   }
   write_candidates(e.link_candidates);
+  csv_.add(e.sigma_force);
+  csv_.add(e.sigma_moment);
+  csv_.add(e.sigma_line);
+  csv_.add(e.sigma_point);
   csv_.end_row();
 }
 

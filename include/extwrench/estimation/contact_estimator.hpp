@@ -13,6 +13,7 @@
 //   7. isolation                 the contact link                         (detection.hpp)
 //   8. Table I case              (F̂, M̄) by case A–E, known point (15)   (wrench_cases.hpp)
 //   9. contact point             line of action (21) → link surface       (localization.hpp)
+//  10. uncertainty               Σ and 1-σ of every estimate, `uncertain` (uncertainty.hpp)
 // then the consistency of the wrench with τ̂_ext (wrench_cases.hpp). Damped least squares
 // (Remark 6) for D and E: damped_least_squares.hpp.
 //
@@ -116,6 +117,8 @@ class ContactEstimator {
   void contact_point(int link, const WrenchFit& fit, bool contact, std::uint32_t& flags) noexcept;
   void consistency(double t, int link, bool contact, const WrenchFit& fit,
                    std::uint32_t& flags) noexcept;
+  void uncertainty(int link, const WrenchFit& fit, std::uint32_t& flags) noexcept;
+  void sensor_force_uncertainty() noexcept;
 
   Status validate_sample(double t, const Eigen::Ref<const VectorX>& q,
                          const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau,
@@ -134,6 +137,7 @@ class ContactEstimator {
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
   IsolationWorkspace isolation_ws_;
+  NoiseModel noise_;  ///< options_.uncertainty as variances, the sensor's in W
   int n_ = 0;
   bool differentiation_ = false;  ///< route (a)
   bool need_ddq_ = false;         ///< q̈̂ needed: a sensor, or route (a)
@@ -150,6 +154,7 @@ class ContactEstimator {
   int release_link_ = -1;  ///< contact link of the last sample (−1: none), for the release
   Vector3 release_point_L_ = Vector3::Zero();  ///< its contact point (link frame), else O_l
   SpectrumGuess spectrum_;  ///< of J Jᵀ at the last damped solve (cases D, E); size 0 after reset
+  Vector3 surface_normal_W_ = Vector3::Zero();  ///< outward normal at the surface point (stage 9)
 
   // Scratch, sized once.
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;

@@ -9,6 +9,7 @@
 #include "extwrench/estimation/damped_least_squares.hpp"
 #include "extwrench/estimation/detection.hpp"
 #include "extwrench/estimation/isolation.hpp"
+#include "extwrench/estimation/uncertainty.hpp"
 #include "extwrench/model/model.hpp"
 #include "extwrench/observer/friction.hpp"
 
@@ -45,6 +46,7 @@ struct EstimatorOptions {
   std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction
   std::optional<PayloadOptions> payload;
   SolverOptions solver;
+  UncertaintyOptions uncertainty;  ///< noise levels and the `uncertain` flag (uncertainty.hpp)
 };
 
 /// Throws extwrench::Error if the options do not fit the model (sizes, link indices, ranges,
