@@ -254,6 +254,12 @@ py::dict metrics_py(const py::dict& truth, const py::dict& estimates, double fro
   d["missed_detections"] = m.missed;
   d["false_alarms"] = m.false_alarms;
   d["false_alarm_rate"] = m.false_alarm_rate();
+  py::dict u;
+  u["samples"] = m.sigma_samples;
+  u["force_within_2sigma"] = m.force_two_sigma_coverage();
+  u["uncertain"] = m.uncertain;
+  u["large_force_error_unflagged"] = m.large_force_error_unflagged;
+  d["uncertainty"] = u;
   d["onsets"] = m.onsets;
   d["onsets_detected"] = m.onsets_detected;
   d["mean_detection_delay"] = m.mean_detection_delay();

@@ -15,9 +15,9 @@ void ContactEstimator::sensor_force_uncertainty() noexcept {
 }
 
 // 10. In: the link, the fit of stage 8, J_ = J_l of O_l, out_ of stages 8–9 and the surface
-// normal of stage 9. Out: out_'s covariances and 1-σ; kUncertain in `flags` when the force's
-// error bound is too large a share of it. The observable part of a rank-deficient case (partial)
-// is not propagated: its σ stay NaN.
+// normal of stage 9. Out: out_'s covariances and 1-σ; kUncertain in `flags` when, in contact,
+// the force's error bound is too large a share of it. The observable part of a rank-deficient case
+// (partial) is not propagated: its σ stay NaN.
 void ContactEstimator::uncertainty(int link, const WrenchFit& fit, std::uint32_t& flags) noexcept {
   const SensorType type = options_.sensor.type;
   if (!fit.ok) {
@@ -48,7 +48,8 @@ void ContactEstimator::uncertainty(int link, const WrenchFit& fit, std::uint32_t
       }
     }
   }
-  if (std::isfinite(out_.sigma_force) &&
+  // Judged for a declared contact only: a free sample's force is ~0, its relative error moot.
+  if (out_.contact && std::isfinite(out_.sigma_force) &&
       force_uncertain(out_.sigma_force, out_.force_W.norm(), options_.uncertainty))
     flags |= EstimateFlag::kUncertain;
 }

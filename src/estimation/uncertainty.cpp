@@ -64,7 +64,8 @@ Matrix6 force_sensor_case(const Matrix6X& J, int link, const WrenchFit& fit,
   out.topRightCorner<3, 3>() = out.bottomLeftCorner<3, 3>().transpose();
   out.bottomRightCorner<3, 3>().noalias() = inverse * torque_part * inverse;
   out.bottomRightCorner<3, 3>().noalias() += gain * noise.force_W * gain.transpose();
-  out.bottomRightCorner<3, 3>() += damping_bias<3>(inverse, fit.damping, fit.moment_O.norm());
+  if (fit.damping > 0.0)
+    out.bottomRightCorner<3, 3>() += damping_bias<3>(inverse, fit.damping, fit.moment_O.norm());
   return out;
 }
 
@@ -77,7 +78,7 @@ Matrix6 no_sensor_case(const Matrix6X& J, int link, const WrenchFit& fit,
   x << fit.force_W, fit.moment_O;
   Matrix6 out;
   out.noalias() = inverse * weighted_gram<6>(J, link, noise.residual_variance) * inverse;
-  out += damping_bias<6>(inverse, fit.damping, x.norm());
+  if (fit.damping > 0.0) out += damping_bias<6>(inverse, fit.damping, x.norm());
   return out;
 }
 
