@@ -63,7 +63,7 @@ BatchInput read_batch(const Estimator& e, const py::handle& t, const py::handle&
 /// The output columns, allocated with the GIL held and written without it.
 struct BatchOutput {
   py::array_t<double> t, force, moment, point, point_L, line_point, line_direction, surface, cond,
-      residual;
+      residual, sigma_f, sigma_m, sigma_line, sigma_point;
   py::array_t<bool> contact;
   py::array_t<std::int32_t> link, status;
   py::array_t<std::uint32_t> flags;
@@ -81,6 +81,10 @@ struct BatchOutput {
         surface(rows),
         cond(rows),
         residual({rows, static_cast<py::ssize_t>(n)}),
+        sigma_f(rows),
+        sigma_m(rows),
+        sigma_line(rows),
+        sigma_point(rows),
         contact(rows),
         link(rows),
         status(rows),
@@ -90,7 +94,7 @@ struct BatchOutput {
 
 struct RowWriter {
   double *t, *force, *moment, *point, *point_L, *line_point, *line_direction, *surface, *cond,
-      *residual;
+      *residual, *sigma_f, *sigma_m, *sigma_line, *sigma_point;
   bool* contact;
   std::int32_t *link, *status;
   std::uint32_t* flags;
@@ -113,6 +117,10 @@ struct RowWriter {
         surface(o.surface.mutable_data()),
         cond(o.cond.mutable_data()),
         residual(o.residual.mutable_data()),
+        sigma_f(o.sigma_f.mutable_data()),
+        sigma_m(o.sigma_m.mutable_data()),
+        sigma_line(o.sigma_line.mutable_data()),
+        sigma_point(o.sigma_point.mutable_data()),
         contact(o.contact.mutable_data()),
         link(o.link.mutable_data()),
         status(o.status.mutable_data()),
@@ -157,6 +165,10 @@ struct RowWriter {
     cond[k] = e.condition_number;
     flags[k] = e.flags;
     link_candidates[k] = e.link_candidates;
+    sigma_f[k] = e.sigma_force;
+    sigma_m[k] = e.sigma_moment;
+    sigma_line[k] = e.sigma_line;
+    sigma_point[k] = e.sigma_point;
     status[k] = status_of(e);
     double* r = residual + k * static_cast<std::size_t>(n);
     for (int i = 0; i < n; ++i) r[i] = e.residual.size() == n ? e.residual[i] : std::nan("");
@@ -234,6 +246,10 @@ py::dict estimate_batch(const Estimator& source, const py::handle& t, const py::
   d["surface_distance"] = out.surface;
   d["flags"] = out.flags;
   d["link_candidates"] = out.link_candidates;
+  d["sigma_f"] = out.sigma_f;
+  d["sigma_m"] = out.sigma_m;
+  d["sigma_line"] = out.sigma_line;
+  d["sigma_point"] = out.sigma_point;
   return d;
 }
 

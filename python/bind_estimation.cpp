@@ -178,6 +178,21 @@ void bind_estimate(py::module_& m) {
       .def_property_readonly(
           "force_W", [](const Estimate& e) { return e.value.force_W; }, "(3,) F_ext [N].")
       .def_property_readonly(
+          "sigma_force", [](const Estimate& e) { return e.value.sigma_force; },
+          "1-sigma of force_W, sqrt(trace) of its covariance [N] (docs/estimator.md#uncertainty).")
+      .def_property_readonly(
+          "sigma_moment", [](const Estimate& e) { return e.value.sigma_moment; },
+          "1-sigma of moment_W [N m].")
+      .def_property_readonly(
+          "sigma_line", [](const Estimate& e) { return e.value.sigma_line; },
+          "1-sigma of the line of action's offset at the reported point [m].")
+      .def_property_readonly(
+          "sigma_point", [](const Estimate& e) { return e.value.sigma_point; },
+          "1-sigma of the surface point [m].")
+      .def_property_readonly(
+          "force_covariance_W", [](const Estimate& e) { return e.value.force_covariance_W; },
+          "(3, 3) covariance of force_W [N^2].")
+      .def_property_readonly(
           "moment_W", [](const Estimate& e) { return e.value.moment_W; },
           "(3,) pure moment M_ext [N m] (known point).")
       .def_property_readonly(

@@ -128,6 +128,9 @@ struct EstimateRows {
   std::vector<std::string> status;
   /// Bit l: body l (the estimates.csv column link_candidates); absent in older dicts.
   py::array_t<std::uint64_t> link_candidates;
+  /// The 1-σ columns (sigma_f, sigma_m, sigma_line, sigma_point); absent in older dicts: NaN.
+  RealArray sigma[4];
+  bool has_sigma[4] = {false, false, false, false};
   py::ssize_t rows = 0;
   int n = 0;
 
@@ -153,6 +156,11 @@ struct EstimateRows {
                               " unsigned integers (bit l: body l)");
       }
     }
+    const char* sigma_names[4] = {"sigma_f", "sigma_m", "sigma_line", "sigma_point"};
+    for (int i = 0; i < 4; ++i) {
+      has_sigma[i] = d.contains(sigma_names[i]);
+      if (has_sigma[i]) sigma[i] = column(d, "estimates", sigma_names[i], rows, -1);
+    }
     if (d.contains("status")) status = d["status"].cast<std::vector<std::string>>();
     if (!status.empty() && static_cast<py::ssize_t>(status.size()) != rows) {
       throw py::value_error("estimates['status']: expected " + std::to_string(rows) + " entries");
@@ -173,6 +181,11 @@ struct EstimateRows {
     for (int i = 0; i < n; ++i) e.residual[i] = residual.at(k, i);
     e.flags = static_cast<std::uint32_t>(flags.at(k));
     e.link_candidates = link_candidates ? link_candidates.at(k) : 0;
+    const auto sigma_at = [&](int i) { return has_sigma[i] ? sigma[i].at(k) : std::nan(""); };
+    e.sigma_force = sigma_at(0);
+    e.sigma_moment = sigma_at(1);
+    e.sigma_line = sigma_at(2);
+    e.sigma_point = sigma_at(3);
     e.status = status.empty() ? Status{} : parse_status(status[static_cast<std::size_t>(k)]);
   }
 };
@@ -241,6 +254,12 @@ py::dict metrics_py(const py::dict& truth, const py::dict& estimates, double fro
   d["missed_detections"] = m.missed;
   d["false_alarms"] = m.false_alarms;
   d["false_alarm_rate"] = m.false_alarm_rate();
+  py::dict u;
+  u["samples"] = m.sigma_samples;
+  u["force_within_2sigma"] = m.force_two_sigma_coverage();
+  u["uncertain"] = m.uncertain;
+  u["large_force_error_unflagged"] = m.large_force_error_unflagged;
+  d["uncertainty"] = u;
   d["onsets"] = m.onsets;
   d["onsets_detected"] = m.onsets_detected;
   d["mean_detection_delay"] = m.mean_detection_delay();

@@ -352,6 +352,7 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
   cal.friction.joint_smoothing = VectorX::Zero(n);
   if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift = VectorX::Zero(n);
   cal.tau_threshold = VectorX::Zero(n);
+  cal.residual_noise = VectorX::Zero(n);
   cal.tau_per_speed = VectorX::Zero(n);
   const double rate = o.false_alarms_per_hour / 3600.0 / n;
   for (int i = 0; i < n; ++i) {
@@ -383,6 +384,7 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
       cal.tau_per_speed[i] = j.threshold_per_speed;
     }
     cal.tau_threshold[i] = j.threshold;
+    cal.residual_noise[i] = j.noise_std;
     cal.joints.push_back(j);
   }
 }

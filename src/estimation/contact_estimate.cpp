@@ -45,6 +45,7 @@ std::string describe_flags(std::uint32_t flags) {
       {EstimateFlag::kAmbiguous, "ambiguous"},
       {EstimateFlag::kResidualIsolation, "residual_isolation"},
       {EstimateFlag::kPartial, "partial"},
+      {EstimateFlag::kUncertain, "uncertain"},
   };
   std::string out;
   for (const auto& e : kNames) {

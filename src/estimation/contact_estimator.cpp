@@ -41,6 +41,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
       observer_(model_, options_.observer_gain),
       detector_(options_.detection, model_.nq(), settle_time_of(options_, observer_)),
       isolation_ws_(model_),
+      noise_(make_noise_model(options_.uncertainty, model_.nq(), options_.sensor.X_WS.rotation)),
       n_(model_.nq()),
       differentiation_(options_.acceleration == AccelerationRoute::kDifferentiation),
       need_ddq_(options_.sensor.type != SensorType::kNone || differentiation_) {
@@ -360,6 +361,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   }
   release_link_ = det.contact && link >= 0 ? link : -1;
   if (link < 0) {
+    if (has_sensor) sensor_force_uncertainty();  // 10
     out_.flags = flags;
     disagreement_on_ = false;
     have_disagreement_edge_ = false;
@@ -370,6 +372,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   if (out_.status.ok()) fit = table_one_case(link, base, flags);  // 8
   contact_point(link, fit, det.contact, flags);                   // 9
   consistency(t, link, det.contact, fit, flags);
+  uncertainty(link, fit, flags);  // 10
   release_point_L_ = out_.point_L.allFinite() ? out_.point_L : Vector3::Zero();
   out_.flags = flags;
 }
@@ -515,7 +518,7 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
   } else if (fit.ok && contact) {
     if (line_of_action(fit, O_l, out_.line_point_W, out_.line_direction_W)) {
       flags |= EstimateFlag::kLineOfAction;
-      locate_on_surface(geometry_, link, X_WL, out_, flags);
+      locate_on_surface(geometry_, link, X_WL, out_, flags, surface_normal_W_);
     }
   }
 }
@@ -525,8 +528,9 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
 // than the residual's transient. Out: kDisagreement in `flags`.
 void ContactEstimator::consistency(double t, int link, bool contact, const WrenchFit& fit,
                                    std::uint32_t& flags) noexcept {
-  const bool inconsistent = contact && fit.ok && !fit.damped && link > 0 &&
-                            contradicts_residual(J_, fit, tau_ext_, detector_.thresholds(), tau_pred_);
+  const bool inconsistent =
+      contact && fit.ok && !fit.damped && link > 0 &&
+      contradicts_residual(J_, fit, tau_ext_, detector_.thresholds(), tau_pred_);
   if (inconsistent) {
     if (!have_disagreement_edge_) {
       have_disagreement_edge_ = true;

@@ -56,6 +56,25 @@ void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   }
 }
 
+void validate_uncertainty(const UncertaintyOptions& u, int n, const std::string& where) {
+  const VectorX& s = u.residual_sigma;
+  if (s.size() != 1 && s.size() != n) {
+    throw Error(where + ": uncertainty.residual_sigma: expected 1 or " + std::to_string(n) +
+                " values, got " + std::to_string(s.size()));
+  }
+  const auto non_negative = [](const auto& v) { return v.allFinite() && (v.array() >= 0.0).all(); };
+  if (!non_negative(s))
+    throw Error(where + ": uncertainty.residual_sigma: expected finite values >= 0 [N m]");
+  if (!non_negative(u.sensor_force_sigma))
+    throw Error(where + ": uncertainty.sensor_force_sigma: expected finite values >= 0 [N]");
+  if (!non_negative(u.sensor_moment_sigma))
+    throw Error(where + ": uncertainty.sensor_moment_sigma: expected finite values >= 0 [N m]");
+  if (!(u.uncertain_fraction > 0.0) || !std::isfinite(u.uncertain_fraction))
+    throw Error(where + ": uncertainty.uncertain_fraction: expected a finite value > 0");
+  if (!(u.uncertain_sigmas > 0.0) || !std::isfinite(u.uncertain_sigmas))
+    throw Error(where + ": uncertainty.uncertain_sigmas: expected a finite value > 0");
+}
+
 }  // namespace
 
 bool finite_inertia(const Inertia& in) noexcept {
@@ -81,6 +100,7 @@ void validate(const EstimatorOptions& o, const Model& model) {
   // The observer's and the detector's own checks, in the order the estimator builds them.
   const int n = model.nq();
   if (n < 1) throw Error("MomentumObserver: model '" + model.name + "' has no joint");
+  validate_uncertainty(o.uncertainty, n, where);
   (void)MomentumObserver::checked_gains(o.observer_gain, n);
   validate_friction(JointFriction::from_model(model), n,
                     "MomentumObserver: model '" + model.name + "'");

@@ -7,7 +7,7 @@
 namespace extwrench {
 
 void locate_on_surface(const GeometryModel& geometry, int link, const Pose& X_WL,
-                       ContactEstimate& out, std::uint32_t& flags) noexcept {
+                       ContactEstimate& out, std::uint32_t& flags, Vector3& normal_W) noexcept {
   const auto l = static_cast<std::size_t>(link);
   if (geometry.body_shapes[l].empty()) {
     flags |= EstimateFlag::kNoGeometry;
@@ -18,6 +18,7 @@ void locate_on_surface(const GeometryModel& geometry, int link, const Pose& X_WL
   if (res.hit) {
     out.point_W = res.entry.point_W;  // smallest λ: the pushing point (21)
     out.surface_distance = 0.0;
+    normal_W = res.entry.normal_W;
     flags |= EstimateFlag::kSurfacePoint;
   } else if (std::isfinite(res.distance)) {
     out.point_W = res.closest_point_W;  // the line misses the link: nearest surface point

@@ -213,6 +213,7 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
     Calibration c;
     c.source = path.string();
     const io_detail::Range positive = io_detail::positive();
+    const io_detail::Range non_negative = io_detail::non_negative(">= 0 [N]");
     const YAML::Node ob = rd.required(root, "", "observer");
     rd.only_keys(ob, "observer", {"gain"});
     c.observer_gain = rd.vector(rd.required(ob, "observer", "gain"), "observer.gain", n, &positive);
@@ -233,9 +234,25 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
     if (c.sensor_type != SensorType::kNone) {
       const VectorX bias = rd.vector(rd.required(sensor, "sensor", "bias"), "sensor.bias", 6);
       c.sensor_bias_S = bias;
+      if (sensor["force_noise_W"])
+        c.force_noise_W =
+            rd.vector(sensor["force_noise_W"], "sensor.force_noise_W", 3, &non_negative);
       rd.set_number_in(det, "detection", "f_min", {0, 1e12, true, "> 0 [N]"}, c.force_threshold);
       if (!(c.force_threshold > 0))
         rd.fail(det, "detection.f_min", "missing (required with a sensor)");
+    }
+    // The residual's noise per joint (fit.joints[i].noise_std; the rest of the report is not read).
+    if (const YAML::Node fit = root["fit"]; fit && fit.IsMap() && fit["joints"]) {
+      const YAML::Node joints = fit["joints"];
+      if (!joints.IsSequence() || static_cast<int>(joints.size()) != n)
+        rd.fail(joints, "fit.joints", "expected one entry per joint (" + std::to_string(n) + ")");
+      c.residual_noise = VectorX::Zero(n);
+      for (std::size_t i = 0; i < joints.size(); ++i) {
+        if (joints[i]["noise_std"]) {
+          c.residual_noise[static_cast<Eigen::Index>(i)] = rd.number_in(
+              joints[i]["noise_std"], "fit.joints.noise_std", {0, 1e12, false, ">= 0 [N m]"});
+        }
+      }
     }
     if (const YAML::Node p = root["payload"]) {
       rd.only_keys(p, "payload",

@@ -107,6 +107,20 @@ void read_friction(const YamlReader& rd, const YAML::Node& f, int n, EstimatorOp
   o.friction = io_detail::read_friction_mapping(rd, f, n, "friction");
 }
 
+// The calibration's noise levels where the configuration's uncertainty: sets none: the residual's
+// std per joint, and the sensor force's std per world axis taken into S (the diagonal of
+// R_WSᵀ diag(σ_W²) R_WS; exact for an aligned sensor). The moment's noise is not measured.
+void calibrated_noise(const YAML::Node& root, const Calibration& cal, EstimatorOptions& o) {
+  const YAML::Node u = root["uncertainty"];
+  if (!(u && u["residual_sigma"]) && cal.residual_noise.size() > 0)
+    o.uncertainty.residual_sigma = cal.residual_noise;
+  if (!(u && u["sensor_force_sigma"]) && cal.sensor_type != SensorType::kNone) {
+    const Matrix3& R = o.sensor.X_WS.rotation;
+    const Matrix3 in_S = R.transpose() * cal.force_noise_W.cwiseAbs2().asDiagonal() * R;
+    o.uncertainty.sensor_force_sigma = in_S.diagonal().cwiseSqrt();
+  }
+}
+
 // `calibration: CALIB.yaml` (relative to the configuration): friction, thresholds and sensor
 // bias from `extwrench calibrate`. Keys the configuration sets itself (friction,
 // detection.tau_min, detection.tau_per_speed, detection.f_min, sensor.tare) win over the
@@ -148,6 +162,7 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
                 "' identified a payload on the last link, this configuration has one on another "
                 "link");
   }
+  calibrated_noise(root, cal, o);
   if (cal.sensor_type != SensorType::kNone) {
     if (!(det && det["f_min"])) o.detection.f_min = cal.force_threshold;
     if (o.sensor.tare_samples == 0) o.sensor.bias_S = cal.sensor_bias_S;
@@ -230,6 +245,31 @@ void read_solver(const YamlReader& rd, const YAML::Node& s, SolverOptions& o) {
   rd.set_number_in(s, "solver", "rank_tolerance", {0, 1, true, "in (0, 1)"}, o.rank_tolerance);
 }
 
+// uncertainty: {residual_sigma, sensor_force_sigma, sensor_moment_sigma, uncertain_fraction,
+// uncertain_sigmas} (docs/config.md#uncertainty); a sigma is one number for all or one per joint
+// / sensor axis.
+void read_uncertainty(const YamlReader& rd, const YAML::Node& u, int n, UncertaintyOptions& o) {
+  rd.only_keys(u, "uncertainty",
+               {"residual_sigma", "sensor_force_sigma", "sensor_moment_sigma", "uncertain_fraction",
+                "uncertain_sigmas"});
+  const Range torque = io_detail::non_negative(">= 0 [N m]");
+  const Range force = io_detail::non_negative(">= 0 [N]");
+  if (u["residual_sigma"])
+    o.residual_sigma = rd.vector(u["residual_sigma"], "uncertainty.residual_sigma", n, &torque);
+  if (u["sensor_force_sigma"]) {
+    o.sensor_force_sigma =
+        rd.vector(u["sensor_force_sigma"], "uncertainty.sensor_force_sigma", 3, &force);
+  }
+  if (u["sensor_moment_sigma"]) {
+    o.sensor_moment_sigma =
+        rd.vector(u["sensor_moment_sigma"], "uncertainty.sensor_moment_sigma", 3, &torque);
+  }
+  rd.set_number_in(u, "uncertainty", "uncertain_fraction", {0, 1e12, true, "> 0"},
+                   o.uncertain_fraction);
+  rd.set_number_in(u, "uncertainty", "uncertain_sigmas", {0, 1e12, true, "> 0"},
+                   o.uncertain_sigmas);
+}
+
 // The robot file, relative to the configuration, loaded with the configuration's gravity.
 void read_robot(const YamlReader& rd, const YAML::Node& root, const fs::path& source,
                 LoadOptions robot_options, EstimatorConfig& cfg) {
@@ -256,7 +296,7 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   rd.only_keys(root, "",
                {"robot", "locked_joints", "gravity", "sensor", "contact", "observer", "detection",
                 "acceleration", "friction", "armature", "payload", "solver", "isolation",
-                "calibration", "drift"});
+                "uncertainty", "calibration", "drift"});
   EstimatorConfig cfg;
   cfg.source = source;
   read_robot(rd, root, source, robot_options, cfg);
@@ -283,6 +323,7 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (root["payload"]) read_payload(rd, root["payload"], model, o);
   if (root["solver"]) read_solver(rd, root["solver"], o.solver);
   if (root["isolation"]) read_isolation(rd, root["isolation"], o.isolation);
+  if (root["uncertainty"]) read_uncertainty(rd, root["uncertainty"], n, o.uncertainty);
   if (root["drift"]) read_drift(rd, root["drift"], o.drift);
   if (root["calibration"]) read_calibration(rd, root, source, n, o);
 
@@ -405,6 +446,12 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
     y << "tolerance: " << iso.tolerance << ", ambiguity_distance: " << iso.ambiguity_distance
       << "}\n";
   }
+  const UncertaintyOptions& u = o.uncertainty;
+  y << "uncertainty:\n  residual_sigma: " << io_detail::yaml_list(u.residual_sigma)
+    << "\n  sensor_force_sigma: " << list3(u.sensor_force_sigma)
+    << "\n  sensor_moment_sigma: " << list3(u.sensor_moment_sigma)
+    << "\n  uncertain_fraction: " << u.uncertain_fraction
+    << "\n  uncertain_sigmas: " << u.uncertain_sigmas << '\n';
   if (o.drift) {
     y << "drift: {time_constant: " << o.drift->time_constant
       << ", max_torque_rate: " << o.drift->max_torque_rate

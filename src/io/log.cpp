@@ -252,7 +252,8 @@ std::vector<std::string> estimates_columns(int n, bool drift) {
                              "px", "py",      "pz",   "lx", "ly", "lz", "status", "cond"};
   for (const auto& r : numbered("r", n)) c.push_back(r);
   c.push_back("link_candidates");  // issue 9: appended, so the older columns keep their places
-  if (drift) {                     // only with drift tracking on (EstimatorOptions::drift)
+  for (const char* sigma : {"sigma_f", "sigma_m", "sigma_line", "sigma_point"}) c.push_back(sigma);
+  if (drift) {  // only with drift tracking on (EstimatorOptions::drift)
     for (const auto& o : numbered("offset", n)) c.push_back(o);
     for (const char* b : {"bias_fx", "bias_fy", "bias_fz", "bias_mx", "bias_my", "bias_mz"})
       c.push_back(b);
@@ -324,6 +325,10 @@ void EstimatesWriter::write(const ContactEstimate& e) {
     csv_.add(e.residual.size() == n_ ? e.residual[i] : std::nan(""));
   }
   write_candidates(e.link_candidates);
+  csv_.add(e.sigma_force);
+  csv_.add(e.sigma_moment);
+  csv_.add(e.sigma_line);
+  csv_.add(e.sigma_point);
   if (drift_columns_) {
     for (int i = 0; i < n_; ++i)
       csv_.add(e.torque_offset.size() == n_ ? e.torque_offset[i] : std::nan(""));

@@ -93,7 +93,12 @@ std::string metrics_json(const MetricsReport& r) {
     o += "      \"right_link_samples\": " + std::to_string(m.right_link) + ",\n";
     o += "      \"missed_detections\": " + std::to_string(m.missed) + ",\n";
     o += "      \"false_alarms\": " + std::to_string(m.false_alarms) + ",\n";
-    o += "      \"false_alarm_rate\": " + num(m.false_alarm_rate()) + "\n";
+    o += "      \"false_alarm_rate\": " + num(m.false_alarm_rate()) + ",\n";
+    o += "      \"uncertainty\": {\"samples\": " + std::to_string(m.sigma_samples) +
+         ", \"force_within_2sigma\": " + num(m.force_two_sigma_coverage()) +
+         ", \"uncertain\": " + std::to_string(m.uncertain) +
+         ", \"large_force_error_unflagged\": " + std::to_string(m.large_force_error_unflagged) +
+         "}\n";
     o += "    }";
   }
   o += "\n  ],\n";

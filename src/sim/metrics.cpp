@@ -3,6 +3,9 @@
 #include <cmath>
 
 namespace extwrench::sim {
+namespace {
+constexpr double kLargeForceError = 0.5;  // share of ‖F‖ a force error must never reach unflagged
+}  // namespace
 
 bool MetricsWindow::contains(double t) const noexcept {
   if (t < from || t > to) return false;
@@ -30,6 +33,11 @@ double Metrics::isolation_accuracy() const noexcept {
 double Metrics::false_alarm_rate() const noexcept {
   return free_samples > 0 ? static_cast<double>(false_alarms) / static_cast<double>(free_samples)
                           : std::nan("");
+}
+double Metrics::force_two_sigma_coverage() const noexcept {
+  return sigma_samples > 0
+             ? static_cast<double>(force_within_two_sigma) / static_cast<double>(sigma_samples)
+             : std::nan("");
 }
 double Metrics::mean_detection_delay() const noexcept {
   return onsets_detected > 0 ? delay_sum / static_cast<double>(onsets_detected) : std::nan("");
@@ -97,6 +105,15 @@ void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate
   }
   if (est.contact && est.has(EstimateFlag::kSurfacePoint))
     m_.surface.add((est.point_W - truth.point_W).norm());
+  if (est.contact && est.has(EstimateFlag::kForce) && std::isfinite(est.sigma_force)) {
+    const double error = (est.force_W - truth.force_W).norm();
+    const bool flagged = est.has(EstimateFlag::kUncertain);
+    ++m_.sigma_samples;
+    if (error <= 2.0 * est.sigma_force) ++m_.force_within_two_sigma;
+    if (flagged) ++m_.uncertain;
+    if (error > kLargeForceError * truth.force_W.norm() && !flagged)
+      ++m_.large_force_error_unflagged;
+  }
 }
 
 Metrics MetricsAccumulator::result() const { return m_; }

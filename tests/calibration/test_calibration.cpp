@@ -282,6 +282,14 @@ TEST(CalibrationFile, SpeedThresholdsRoundTripAndOldFilesStillLoad) {
       load_estimator_config_string(head + "calibration: calib.yaml\n", dir / "config.yaml");
   EXPECT_TRUE(cfg.options.detection.tau_per_speed.isApprox(cal.tau_per_speed, 1e-15));
   EXPECT_TRUE(cfg.options.detection.tau_min.isApprox(cal.tau_threshold, 1e-15));
+  // The residual's noise per joint becomes the uncertainty's (the report keeps 6 digits), unless
+  // the configuration sets it.
+  ASSERT_EQ(cfg.options.uncertainty.residual_sigma.size(), 7);
+  EXPECT_GT(cal.residual_noise.minCoeff(), 0.0);
+  EXPECT_TRUE(cfg.options.uncertainty.residual_sigma.isApprox(cal.residual_noise, 1e-5));
+  const EstimatorConfig own_noise = load_estimator_config_string(
+      head + "uncertainty: {residual_sigma: 0.2}\ncalibration: calib.yaml\n", dir / "config.yaml");
+  EXPECT_EQ(own_noise.options.uncertainty.residual_sigma, VectorX::Constant(7, 0.2));
   // The configuration written back keeps the speed term (to_yaml) and reads back the same.
   const std::string written = to_yaml(cfg, dir);
   const EstimatorConfig again = load_estimator_config_string(written, dir / "written.yaml");

@@ -42,6 +42,12 @@ TEST(EstimatorConfig, ReadsEveryKeyOfAFullFile) {
   EXPECT_EQ(o.payload->inertia.inertia_com(2, 2), 0.0005);
   EXPECT_EQ(o.solver.max_condition, 2000.0);
   EXPECT_EQ(o.solver.rank_tolerance, 1e-6);
+  EXPECT_EQ(o.uncertainty.residual_sigma.size(), 7);
+  EXPECT_EQ(o.uncertainty.residual_sigma[3], 0.05);
+  EXPECT_EQ(o.uncertainty.sensor_force_sigma, Vector3(0.5, 0.5, 0.8));
+  EXPECT_EQ(o.uncertainty.sensor_moment_sigma, Vector3::Constant(0.05));
+  EXPECT_EQ(o.uncertainty.uncertain_fraction, 0.4);
+  EXPECT_EQ(o.uncertainty.uncertain_sigmas, 2.0);
 }
 
 TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {
@@ -124,6 +130,14 @@ TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
     EXPECT_EQ(x.friction.has_value(), y.friction.has_value()) << file;
     EXPECT_EQ(x.payload.has_value(), y.payload.has_value()) << file;
     EXPECT_EQ(x.solver.max_condition, y.solver.max_condition) << file;
+    EXPECT_EQ(x.uncertainty.residual_sigma.minCoeff(), y.uncertainty.residual_sigma.minCoeff())
+        << file;
+    EXPECT_EQ(x.uncertainty.residual_sigma.maxCoeff(), y.uncertainty.residual_sigma.maxCoeff())
+        << file;
+    EXPECT_EQ(x.uncertainty.sensor_force_sigma, y.uncertainty.sensor_force_sigma) << file;
+    EXPECT_EQ(x.uncertainty.sensor_moment_sigma, y.uncertainty.sensor_moment_sigma) << file;
+    EXPECT_EQ(x.uncertainty.uncertain_fraction, y.uncertainty.uncertain_fraction) << file;
+    EXPECT_EQ(x.uncertainty.uncertain_sigmas, y.uncertainty.uncertain_sigmas) << file;
     EXPECT_TRUE(a.robot.model.gravity == b.robot.model.gravity) << file;
   }
 }
@@ -201,6 +215,14 @@ INSTANTIATE_TEST_SUITE_P(
             ":3:", "payload.inertia", "payload"},
         BadConfig{"sensor: {type: ft}\nsolver: {max_condition: 0.5}\n",
                   ":3:", "solver.max_condition", "> 1"},
+        BadConfig{"sensor: {type: ft}\nuncertainty: {residual_sigma: [1, 2]}\n",
+                  ":3:", "uncertainty.residual_sigma", "7 values"},
+        BadConfig{"sensor: {type: ft}\nuncertainty: {sensor_force_sigma: -0.5}\n",
+                  ":3:", "uncertainty.sensor_force_sigma", ">= 0"},
+        BadConfig{"sensor: {type: ft}\nuncertainty: {uncertain_fraction: 0}\n",
+                  ":3:", "uncertainty.uncertain_fraction", "> 0"},
+        BadConfig{"sensor: {type: ft}\nuncertainty: {sigma: 1}\n", ":3:", "uncertainty.sigma",
+                  "unknown key"},
         BadConfig{"sensor: {type: ft}\ndrift: {time_constant: 0}\n", ":3:", "drift.time_constant",
                   "> 0"},
         BadConfig{"sensor: {type: ft}\ndrift: {max_rate: 1}\n", ":3:", "drift.max_rate",

@@ -371,5 +371,32 @@ TEST(Metrics, CountsFalseAlarmsMissesAndDetectionDelay) {
   EXPECT_NEAR(m.isolation_accuracy(), 1.0 / 3.0, 1e-15);
 }
 
+TEST(Metrics, CountsTheForcesWithinTwoSigmaAndTheLargeErrorsLeftUnflagged) {
+  MetricsAccumulator acc(MetricsWindow{});
+  Truth contact;
+  contact.body = 2;
+  contact.contacts = 1;
+  contact.force_W = Vector3(0, 0, 10);
+  ContactEstimate e;
+  e.contact = true;
+  e.link = 2;
+  e.flags = EstimateFlag::kContact | EstimateFlag::kForce;
+  e.sigma_force = 1.0;
+  e.force_W = Vector3(0, 0, 11);  // within 2σ
+  acc.add(0.0, contact, e);
+  e.force_W = Vector3(0, 0, 16);  // 6σ off, more than 50 % of ‖F‖, not flagged
+  acc.add(0.1, contact, e);
+  e.flags |= EstimateFlag::kUncertain;  // the same, flagged
+  acc.add(0.2, contact, e);
+  e.sigma_force = ContactEstimate::kNaN;  // no σ: not counted
+  acc.add(0.3, contact, e);
+  const Metrics m = acc.result();
+  EXPECT_EQ(m.sigma_samples, 3);
+  EXPECT_EQ(m.force_within_two_sigma, 1);
+  EXPECT_EQ(m.uncertain, 1);
+  EXPECT_EQ(m.large_force_error_unflagged, 1);
+  EXPECT_NEAR(m.force_two_sigma_coverage(), 1.0 / 3.0, 1e-15);
+}
+
 }  // namespace
 }  // namespace extwrench::sim

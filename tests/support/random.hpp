@@ -23,6 +23,8 @@ class SeededRng {
   Vector3 uniform_vector3(double lo, double hi) {
     return {uniform(lo, hi), uniform(lo, hi), uniform(lo, hi)};
   }
+  /// Standard normal.
+  double normal() { return engine_.normal(); }
   /// 64 random bits.
   std::uint64_t bits() { return engine_.next(); }
 

@@ -117,7 +117,11 @@ struct Calibration {
   SensorType sensor_type = SensorType::kNone;
   Vector6 sensor_bias_S = Vector6::Zero();  ///< [f; n] in S (moment zero for a force sensor)
   Vector3 force_noise_W = Vector3::Zero();  ///< std of F̂_ext per world axis after the bias [N]
-  double force_threshold = 0.0;             ///< F_min after calibration [N] (0: no sensor)
+  /// std of the residual per joint after calibration (n; = joints[i].noise_std) [N m]; what a
+  /// configuration including the file takes as the residual's noise (uncertainty.hpp). Empty
+  /// when loaded from a file without fit.joints.
+  VectorX residual_noise;
+  double force_threshold = 0.0;  ///< F_min after calibration [N] (0: no sensor)
   double false_alarms_per_hour = 1.0;
   PayloadReport payload;  ///< with CalibrationOptions::payload
   ModelCheck model_check;

@@ -61,6 +61,8 @@ struct EstimateFlag {
       1u << 21;  ///< geometry isolation could test no candidate: the paper's rule decided
   static constexpr std::uint32_t kPartial =
       1u << 22;  ///< rank deficient: the observable part only (observable_basis), rest zero
+  static constexpr std::uint32_t kUncertain =
+      1u << 23;  ///< the force's error bound exceeds the configured fraction (uncertainty.hpp)
 };
 
 /// Names of the set bits, separated by '|' ("contact|force|line|surface_point"); "free" for 0.
@@ -93,6 +95,14 @@ struct ContactEstimate {
   /// for a known point, moment) is the minimum-norm solution within it.
   Eigen::Matrix<double, 6, 6> observable_basis_W = Eigen::Matrix<double, 6, 6>::Zero();
   int observable_rank = -1;  ///< dimension of that subspace; −1 when not partial
+  // Uncertainty (docs/estimator.md#uncertainty): covariances in W and their 1-σ = √trace Σ, the
+  // RMS norm of the error; NaN where the quantity is not estimated (or not propagated: partial).
+  Matrix3 force_covariance_W = Matrix3::Constant(kNaN);   ///< Σ of force_W [N²]
+  Matrix3 moment_covariance_W = Matrix3::Constant(kNaN);  ///< Σ of moment_W [N² m²]
+  double sigma_force = kNaN;                              ///< [N]
+  double sigma_moment = kNaN;                             ///< [N m]
+  double sigma_line = kNaN;  ///< of the line's offset ⟂ to it at the reported point (p̂ if none) [m]
+  double sigma_point = kNaN;  ///< of the surface point [m]
   VectorX residual;  ///< τ̂_ext (n) used for isolation: r, or RNEA − τ (differentiation route)
   /// Drift tracking (EstimatorOptions::drift): the joint torque offsets o_i in use (n) and the
   /// sensor bias [f; n] in S after this sample; size 0 / NaN without drift tracking.

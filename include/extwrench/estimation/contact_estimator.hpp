@@ -13,6 +13,7 @@
 //   7. isolation                 the contact link                         (detection.hpp)
 //   8. Table I case              (F̂, M̄) by case A–E, known point (15)   (wrench_cases.hpp)
 //   9. contact point             line of action (21) → link surface       (localization.hpp)
+//  10. uncertainty               Σ and 1-σ of every estimate, `uncertain` (uncertainty.hpp)
 // then the consistency of the wrench with τ̂_ext (wrench_cases.hpp). Damped least squares
 // (Remark 6) for D and E: damped_least_squares.hpp.
 //
@@ -117,6 +118,8 @@ class ContactEstimator {
   void consistency(double t, int link, bool contact, const WrenchFit& fit,
                    std::uint32_t& flags) noexcept;
   void track_drift(double t, const DetectionResult& det, const BaseWrench& base) noexcept;
+  void uncertainty(int link, const WrenchFit& fit, std::uint32_t& flags) noexcept;
+  void sensor_force_uncertainty() noexcept;
 
   Status validate_sample(double t, const Eigen::Ref<const VectorX>& q,
                          const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau,
@@ -135,6 +138,7 @@ class ContactEstimator {
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
   IsolationWorkspace isolation_ws_;
+  NoiseModel noise_;  ///< options_.uncertainty as variances, the sensor's in W
   int n_ = 0;
   bool differentiation_ = false;  ///< route (a)
   bool need_ddq_ = false;         ///< q̈̂ needed: a sensor, or route (a)
@@ -154,6 +158,7 @@ class ContactEstimator {
   double drift_quiet_since_ = 0.0;             ///< last sample with contact, pending or raw [s]
   double drift_t_prev_ = 0.0;
   SpectrumGuess spectrum_;  ///< of J Jᵀ at the last damped solve (cases D, E); size 0 after reset
+  Vector3 surface_normal_W_ = Vector3::Zero();  ///< outward normal at the surface point (stage 9)
 
   // Scratch, sized once.
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;

@@ -30,6 +30,7 @@ struct DlsInfo {
   bool rank_ok = false;  ///< σ_min > rank_tolerance · σ_max
   bool damped = false;   ///< σ_min < σ_max / max_condition: damping active
   double condition = std::numeric_limits<double>::quiet_NaN();
+  double damping = 0.0;  ///< μ² of the solve (uncertainty.hpp propagates through it)
 };
 
 /// Extreme eigenvectors of J Jᵀ at the last solve: where the next solve's power / inverse
@@ -153,6 +154,7 @@ inline DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, int cols, const
   const double eps = s_max / opt.max_condition;  // ε = σ_max / κ_max
   const double mu2 = s_min < eps ? eps * eps - s_min * s_min : 0.0;
   info.damped = mu2 > 0.0;
+  info.damping = mu2;
   bool solved = false;
   if (info.rank_ok) {
     // rank_ok ⇒ σ_min > 0 ⇒ J Jᵀ + μ² I is positive definite (round-off checked).

@@ -9,6 +9,7 @@
 #include "extwrench/estimation/damped_least_squares.hpp"
 #include "extwrench/estimation/detection.hpp"
 #include "extwrench/estimation/isolation.hpp"
+#include "extwrench/estimation/uncertainty.hpp"
 #include "extwrench/model/model.hpp"
 #include "extwrench/observer/friction.hpp"
 
@@ -57,6 +58,7 @@ struct EstimatorOptions {
   std::optional<PayloadOptions> payload;
   SolverOptions solver;
   std::optional<DriftOptions> drift;  ///< opt-in; none: offsets and bias stay as configured
+  UncertaintyOptions uncertainty;     ///< noise levels and the `uncertain` flag (uncertainty.hpp)
 };
 
 /// Throws extwrench::Error if the options do not fit the model (sizes, link indices, ranges,

@@ -11,9 +11,10 @@
 namespace extwrench {
 
 /// Contact-point stage. In: the geometry, the link, its pose X_WL, and out.line_point_W /
-/// out.line_direction_W. Out: out.point_W, out.point_L, out.surface_distance, and one of
-/// kSurfacePoint, kSurfaceMissed, kNoGeometry in `flags`. noexcept, no allocation.
+/// out.line_direction_W. Out: out.point_W, out.point_L, out.surface_distance, one of
+/// kSurfacePoint, kSurfaceMissed, kNoGeometry in `flags`, and the outward surface normal at a
+/// hit (for the point's uncertainty; unchanged otherwise). noexcept, no allocation.
 void locate_on_surface(const GeometryModel& geometry, int link, const Pose& X_WL,
-                       ContactEstimate& out, std::uint32_t& flags) noexcept;
+                       ContactEstimate& out, std::uint32_t& flags, Vector3& normal_W) noexcept;
 
 }  // namespace extwrench

@@ -25,6 +25,7 @@ struct WrenchFit {
   bool damped = false;        ///< damped least squares active (cases D, E)
   bool fitted_force = false;  ///< F̂ comes from the fit (case E), not the sensor
   double condition = std::numeric_limits<double>::quiet_NaN();  ///< κ of the inverted Jacobian
+  double damping = 0.0;  ///< μ² of the damped solve (cases D, E); 0 when undamped
   /// Rank test failed (cases D, E): force_W / moment_O hold the minimum-norm solution on the
   /// observable subspace (ok stays false: no line of action), basis_W its orthonormal basis in
   /// (F; M̄) coordinates, first `rank` columns.
@@ -90,6 +91,7 @@ template <typename Jacobian>
       fit.moment_O = x;
       fit.ok = true;
       fit.damped = info.damped;
+      fit.damping = info.damping;
     } else if (observable_part && link > 0 && base.force_W.allFinite()) {
       partial_moment(J, link, b, solver.rank_tolerance, fit);
     }
@@ -103,6 +105,7 @@ template <typename Jacobian>
       fit.moment_O = x.tail<3>();
       fit.ok = true;
       fit.damped = info.damped;
+      fit.damping = info.damping;
       fit.fitted_force = true;
     } else if (observable_part && link > 0) {
       partial_wrench(J, link, tau_ext, solver.rank_tolerance, fit);

@@ -86,10 +86,10 @@ class LogWriter {
 };
 
 /// The estimates file: t, contact, link, fx fy fz, mx my mz, px py pz, lx ly lz, status, cond,
-/// r1..rn, link_candidates [, offset1..n, bias_fx..bias_mz with drift tracking] (world frame;
-/// quantities not estimated are empty cells; round-trip
-/// precision). link_candidates: the other links geometry isolation found consistent, by name,
-/// '|'-separated (docs/estimator.md#geometry-consistent-isolation).
+/// r1..rn, link_candidates, sigma_f, sigma_m, sigma_line, sigma_point [, offset1..n,
+/// bias_fx..bias_mz with drift tracking] (world frame; quantities not estimated are empty cells;
+/// round-trip precision). link_candidates: the other links geometry isolation found consistent,
+/// by name, '|'-separated (docs/estimator.md#geometry-consistent-isolation).
 class EstimatesWriter {
  public:
   /// `model` gives n and the body names of the link column. `drift_columns`: append

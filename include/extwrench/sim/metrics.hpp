@@ -48,6 +48,11 @@ struct Metrics {
   long right_link = 0;           ///< in contact, detected on the right link
   long missed = 0;               ///< in contact, not detected
   long false_alarms = 0;         ///< free, contact reported
+  // Uncertainty (issue 9): in-contact samples (single contact) with a force and its σ.
+  long sigma_samples = 0;                ///< ... of which counted below
+  long force_within_two_sigma = 0;       ///< ‖F̂ − F‖ ≤ 2 sigma_force
+  long uncertain = 0;                    ///< flagged `uncertain`
+  long large_force_error_unflagged = 0;  ///< ‖F̂ − F‖ > 0.5 ‖F‖ without `uncertain`
   // Detection delay: over the whole log (not windowed), from each onset of contact.
   long onsets = 0;
   long onsets_detected = 0;
@@ -56,6 +61,8 @@ struct Metrics {
 
   [[nodiscard]] double isolation_accuracy() const noexcept;  ///< right_link / contact_samples
   [[nodiscard]] double false_alarm_rate() const noexcept;    ///< false_alarms / free_samples
+  /// force_within_two_sigma / sigma_samples (NaN without such samples).
+  [[nodiscard]] double force_two_sigma_coverage() const noexcept;
   [[nodiscard]] double mean_detection_delay() const noexcept;
 };
 
