@@ -361,7 +361,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   }
   release_link_ = det.contact && link >= 0 ? link : -1;
   if (link < 0) {
-    if (has_sensor) sensor_force_uncertainty();  // 10
+    if (has_sensor && noise_.configured) sensor_force_uncertainty();  // 10
     out_.flags = flags;
     disagreement_on_ = false;
     have_disagreement_edge_ = false;
@@ -372,7 +372,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   if (out_.status.ok()) fit = table_one_case(link, base, flags);  // 8
   contact_point(link, fit, det.contact, flags);                   // 9
   consistency(t, link, det.contact, fit, flags);
-  uncertainty(link, fit, flags);  // 10
+  if (noise_.configured) uncertainty(link, fit, flags);  // 10
   release_point_L_ = out_.point_L.allFinite() ? out_.point_L : Vector3::Zero();
   out_.flags = flags;
 }

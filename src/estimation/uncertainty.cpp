@@ -106,6 +106,9 @@ NoiseModel make_noise_model(const UncertaintyOptions& options, int n, const Matr
   m.residual_variance = s.size() == 1 ? VectorX::Constant(n, s[0] * s[0]) : VectorX(s.cwiseAbs2());
   m.force_W = rotated_diagonal(R_WS, options.sensor_force_sigma);
   m.moment_W = rotated_diagonal(R_WS, options.sensor_moment_sigma);
+  m.configured = (m.residual_variance.array() > 0.0).any() ||
+                 (options.sensor_force_sigma.array() > 0.0).any() ||
+                 (options.sensor_moment_sigma.array() > 0.0).any();
   return m;
 }
 

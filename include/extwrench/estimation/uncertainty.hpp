@@ -31,6 +31,9 @@ struct NoiseModel {
   VectorX residual_variance;           ///< σ² of τ̂_ext per joint (n) [N² m²]
   Matrix3 force_W = Matrix3::Zero();   ///< Σ of the sensor force in W [N²]
   Matrix3 moment_W = Matrix3::Zero();  ///< Σ of the sensor moment in W [N² m²]
+  /// Some level is > 0. Without any (none configured, no calibration) the uncertainty is not
+  /// estimated: σ stay NaN and `uncertain` is never set (a σ of 0 would claim exactness).
+  bool configured = false;
 };
 
 /// The NoiseModel of the options for n joints and the sensor rotation R_WS (sizes validated).
