@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "extwrench/model/sample_models.hpp"
@@ -42,6 +43,19 @@ inline sim::SinusoidalTrajectory free_motion(double phase_shift, double speed) {
   t.frequency *= speed;
   for (int i = 0; i < 7; ++i) t.phase[i] = phase_shift * (i + 1);
   return t;
+}
+
+/// A push of `newtons` tangential to link `link`'s joint axis (y of its frame) at 0.1 m along x,
+/// held over [start, end] s.
+inline sim::ForceProfile tangential_push(int link, double newtons, double start, double end) {
+  sim::ForceProfile push;
+  push.frame = "link" + std::to_string(link);
+  push.axes = sim::ForceProfile::Axes::kFrame;
+  push.point_F = Vector3(0.1, 0.0, 0.0);
+  push.force = Vector3(0.0, newtons, 0.0);
+  push.start = start;
+  push.end = end;
+  return push;
 }
 
 struct SimulatedLog {

@@ -39,16 +39,7 @@ double drift_sign(int i) { return i % 2 == 0 ? 1.0 : -1.0; }
 // rates above (what the robot's torque sensing and the F/T sensor drift by).
 std::vector<Sample> drifting_log(const Model& model, bool push) {
   std::vector<sim::ForceProfile> forces;
-  if (push) {
-    sim::ForceProfile p;
-    p.frame = "link5";
-    p.axes = sim::ForceProfile::Axes::kFrame;
-    p.point_F = Vector3(0.1, 0.0, 0.0);
-    p.force = Vector3(0.0, 15.0, 0.0);
-    p.start = kPushStart;
-    p.end = kPushEnd;
-    forces.push_back(p);
-  }
+  if (push) forces.push_back(test::tangential_push(5, 15.0, kPushStart, kPushEnd));
   auto log = test::simulate_free_motion(model, test::free_motion(0.3, 1.0), offsets_only(),
                                         kDuration, initial_bias(), 0.01, 41, forces);
   for (Sample& s : log) {
