@@ -103,15 +103,10 @@ TEST_P(TableOne, RecoversWhatTheConfigurationAllowsAndFlagsTheRest) {
                     ddq = rng.uniform_vector(n, -2, 2);
       // A point on the link's surface, a force pushing into it (not grazing), a moment for the
       // known-point case.
-      const auto [p_L, normal_L] = test::random_surface_point(shape, rng);
       const Pose X_WL = kdl.compute_body_pose(q, link);
-      const Vector3 p_W = X_WL.act(p_L), normal_W = X_WL.rotation * normal_L;
-      Vector3 dir = rng.uniform_vector3(-1, 1).normalized();
-      if (dir.dot(normal_W) > 0) dir = -dir;
-      if (dir.dot(normal_W) > -0.3) dir = (dir - normal_W).normalized();
-      const Vector3 F = rng.uniform(5, 50) * dir;
-      const Vector3 M =
-          c.contact == ContactModel::kKnownPoint ? rng.uniform_vector3(-2, 2) : Vector3::Zero();
+      const test::SurfacePush push =
+          test::random_surface_push(shape, X_WL, rng, c.contact == ContactModel::kKnownPoint);
+      const Vector3 &p_L = push.p_L, &p_W = push.p_W, &F = push.force_W, &M = push.moment_W;
       const test::KdlReference::Result ref = kdl.compute(q, dq, ddq, link, F, p_W, M);
       const Vector6 reading_S = test::to_sensor_frame(ref.reading_W, opt.sensor.X_WS);
 

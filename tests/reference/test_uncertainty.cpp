@@ -105,14 +105,9 @@ TEST_P(Uncertainty, TwoSigmaCoversNinetyToNinetyNinePercentAndLargeErrorsAreFlag
           q[j - 1] = (rng.uniform(0, 1) < 0.5 ? -1 : 1) * std::pow(10.0, rng.uniform(-3.5, -0.5));
       }
       const VectorX dq = rng.uniform_vector(n, -1, 1), ddq = rng.uniform_vector(n, -2, 2);
-      const auto [p_L, normal_L] = test::random_surface_point(shape, rng);
       const Pose X_WL = kdl.compute_body_pose(q, link);
-      const Vector3 p_W = X_WL.act(p_L), normal_W = X_WL.rotation * normal_L;
-      Vector3 dir = rng.uniform_vector3(-1, 1).normalized();
-      if (dir.dot(normal_W) > 0) dir = -dir;
-      if (dir.dot(normal_W) > -0.3) dir = (dir - normal_W).normalized();
-      const Vector3 F = rng.uniform(5, 50) * dir;
-      const Vector3 M = known_point ? rng.uniform_vector3(-2, 2) : Vector3::Zero();
+      const test::SurfacePush push = test::random_surface_push(shape, X_WL, rng, known_point);
+      const Vector3 &p_L = push.p_L, &p_W = push.p_W, &F = push.force_W, &M = push.moment_W;
       const test::KdlReference::Result ref = kdl.compute(q, dq, ddq, link, F, p_W, M);
       Vector6 reading_S = test::to_sensor_frame(ref.reading_W, opt.sensor.X_WS);
       for (int a = 0; a < 3; ++a) reading_S[a] += kForceSigma * rng.normal();

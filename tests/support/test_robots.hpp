@@ -86,6 +86,25 @@ inline std::pair<Vector3, Vector3> random_surface_point(const CollisionShape& s,
   return {s.placement.act(p_S), s.placement.rotation * normal};
 }
 
+/// A contact at a random point of shape `s` on a link at pose X_WL: the point (link frame and
+/// W), a force of 5-50 N pushing into the surface (its inward normal share at least 0.3: never
+/// grazing) and, `with_moment`, a pure moment in [-2, 2]^3 N m (else zero); all in W.
+struct SurfacePush {
+  Vector3 p_L, p_W, force_W, moment_W;
+};
+inline SurfacePush random_surface_push(const CollisionShape& s, const Pose& X_WL, SeededRng& rng,
+                                       bool with_moment) {
+  const auto [p_L, normal_L] = random_surface_point(s, rng);
+  const Vector3 normal_W = X_WL.rotation * normal_L;
+  Vector3 dir = rng.uniform_vector3(-1, 1).normalized();
+  if (dir.dot(normal_W) > 0) dir = -dir;
+  if (dir.dot(normal_W) > -0.3) dir = (dir - normal_W).normalized();
+  SurfacePush push{p_L, X_WL.act(p_L), Vector3::Zero(), Vector3::Zero()};
+  push.force_W = rng.uniform(5, 50) * dir;
+  if (with_moment) push.moment_W = rng.uniform_vector3(-2, 2);
+  return push;
+}
+
 /// The model as a URDF string (one <link> per body, one revolute/prismatic <joint> per joint,
 /// extra frames omitted), for kdl_parser.
 inline std::string model_to_urdf(const Model& model) {
