@@ -56,13 +56,17 @@ void check_samples(const std::vector<Sample>& samples, int n, bool known_externa
 
 // With a known external torque: the residual's part due to it, the observer's filter of
 // τ_ext,known (the residual answers an external torque as it answers friction, with the
-// opposite sign), taken out of r⁰ so that only the model's error is left to fit.
-void remove_known_torque(const std::vector<Sample>& samples, const std::vector<double>& alpha,
-                         int joint, std::vector<double>& r0) {
+// opposite sign), taken out of r⁰ so that only the model's error is left to fit: from `series`
+// (run without friction) and from `before` (with the configured friction), filtered once.
+void remove_known_torque(const std::vector<Sample>& samples, int joint, JointSeries& series,
+                         JointSeries& before) {
   std::vector<double> tau_ext(samples.size()), filtered;
   for (std::size_t k = 0; k < samples.size(); ++k) tau_ext[k] = samples[k].truth.tau_ext[joint];
-  calibration_detail::filter_regressor(tau_ext, alpha, filtered);
-  for (std::size_t k = 0; k < r0.size(); ++k) r0[k] -= filtered[k];
+  calibration_detail::filter_regressor(tau_ext, series.alpha, filtered);
+  for (std::size_t k = 0; k < filtered.size(); ++k) {
+    series.r0[k] -= filtered[k];
+    before.r0[k] -= filtered[k];
+  }
 }
 
 // The observer over the log with `friction`: residual r_k per joint (N × n), and e^{−K Δt_k}.
@@ -454,10 +458,8 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   run_observer(m, gains, options.friction ? *options.friction : JointFriction::from_model(model),
                samples, before, true);
   if (o.known_external_torque) {
-    for (std::size_t i = 0; i < series.size(); ++i) {
-      remove_known_torque(samples, series[i].alpha, static_cast<int>(i), series[i].r0);
-      remove_known_torque(samples, series[i].alpha, static_cast<int>(i), before[i].r0);
-    }
+    for (std::size_t i = 0; i < series.size(); ++i)
+      remove_known_torque(samples, static_cast<int>(i), series[i], before[i]);
   }
 
   cal.observer_gain = gains;
