@@ -462,8 +462,11 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
   }
   if (fit.damped) flags |= EstimateFlag::kIllConditioned;
   if (!fit.ok) flags |= EstimateFlag::kUnobservable;
+  // A short chain (fewer than 6 joints: rank J_l < 6 whatever q) cannot tell F from M at all;
+  // the force alone is its answer. A longer one at a singularity keeps case E's observable
+  // part: there a pure moment can pass for a force at a short lever, undetectably.
   if (!fit.ok && options_.contact.model == ContactModel::kKnownPoint &&
-      options_.sensor.type == SensorType::kNone)
+      options_.sensor.type == SensorType::kNone && link < 6)
     known_point_force(link, fit, flags);
   if (fit.partial) {
     flags |= EstimateFlag::kPartial;
@@ -486,6 +489,7 @@ void ContactEstimator::known_point_force(int link, WrenchFit& fit, std::uint32_t
   if (rank == 0) return;
   fit.force_W = x;
   fit.partial = true;
+  fit.point_force = true;
   fit.rank = rank;
   fit.basis_W.setZero();
   fit.basis_W.topLeftCorner<3, 3>() = basis;

@@ -27,6 +27,24 @@ bool damped_normal_inverse(const Eigen::MatrixBase<Derived>& J, int cols, double
   return true;
 }
 
+/// The pseudo-inverse of J Jᵀ (J: the first `cols` columns, R×n) on the observable subspace:
+/// Σ_k v_k v_kᵀ / (v_kᵀ J Jᵀ v_k) over the first `rank` columns v_k of `basis`, the eigenvectors
+/// min_norm_solve kept. P J τ̂ is the minimum-norm solution, so P stands for A⁻¹ in a partial fit.
+template <int R, typename Derived, typename Basis>
+Eigen::Matrix<double, R, R> observable_inverse(const Eigen::MatrixBase<Derived>& J, int cols,
+                                               const Eigen::MatrixBase<Basis>& basis,
+                                               int rank) noexcept {
+  Eigen::Matrix<double, R, R> normal;
+  normal.noalias() = J.leftCols(cols) * J.leftCols(cols).transpose();
+  Eigen::Matrix<double, R, R> inverse = Eigen::Matrix<double, R, R>::Zero();
+  for (int k = 0; k < rank; ++k) {
+    const Eigen::Matrix<double, R, 1> v = basis.col(k);
+    const double lambda = v.dot(normal * v);
+    if (lambda > 0.0) inverse.noalias() += (v / lambda) * v.transpose();
+  }
+  return inverse;
+}
+
 /// Σ_i σ_i² a_i a_iᵀ over the first `cols` columns of A (R×n): A Σ_τ Aᵀ without an R×n temporary.
 template <int R, typename Derived>
 Eigen::Matrix<double, R, R> weighted_gram(const Eigen::MatrixBase<Derived>& A, int cols,
@@ -51,7 +69,10 @@ Matrix6 force_sensor_case(const Matrix6X& J, int link, const WrenchFit& fit,
                           const NoiseModel& noise) noexcept {
   Matrix6 out;
   Matrix3 inverse;
-  if (!damped_normal_inverse<3>(J.bottomRows<3>(), link, fit.damping, inverse)) {
+  if (fit.partial) {
+    inverse =
+        observable_inverse<3>(J.bottomRows<3>(), link, fit.basis_W.block<3, 3>(3, 3), fit.rank - 3);
+  } else if (!damped_normal_inverse<3>(J.bottomRows<3>(), link, fit.damping, inverse)) {
     out.setConstant(kNaN);
     return out;
   }
@@ -73,7 +94,11 @@ Matrix6 force_sensor_case(const Matrix6X& J, int link, const WrenchFit& fit,
 Matrix6 no_sensor_case(const Matrix6X& J, int link, const WrenchFit& fit,
                        const NoiseModel& noise) noexcept {
   Matrix6 inverse;
-  if (!damped_normal_inverse<6>(J, link, fit.damping, inverse)) return Matrix6::Constant(kNaN);
+  if (fit.partial) {
+    inverse = observable_inverse<6>(J, link, fit.basis_W, fit.rank);
+  } else if (!damped_normal_inverse<6>(J, link, fit.damping, inverse)) {
+    return Matrix6::Constant(kNaN);
+  }
   Vector6 x;
   x << fit.force_W, fit.moment_O;
   Matrix6 out;
@@ -123,6 +148,29 @@ Matrix6 wrench_covariance(SensorType type, const Matrix6X& J, int link, const Wr
       break;
   }
   return no_sensor_case(J, link, fit, noise);
+}
+
+Matrix3 known_point_force_covariance(const Matrix6X& J_p, int link, const WrenchFit& fit,
+                                     const NoiseModel& noise) noexcept {
+  const auto J_v = J_p.topRows<3>();
+  const Matrix3 inverse =
+      observable_inverse<3>(J_v, link, fit.basis_W.topLeftCorner<3, 3>(), fit.rank);
+  return inverse * weighted_gram<3>(J_v, link, noise.residual_variance) * inverse;
+}
+
+double point_force_misfit(const Matrix6X& J_p, int link, const VectorX& tau_ext,
+                          const WrenchFit& fit, const NoiseModel& noise) noexcept {
+  const int dof = link - fit.rank;
+  if (dof <= 0) return 1.0;
+  double chi2 = 0.0;
+  for (int i = 0; i < link; ++i) {
+    const double variance = noise.residual_variance[i];
+    if (!(variance > 0.0)) return 1.0;  // a joint without a noise level: no scale to judge by
+    const double misfit = tau_ext[i] - J_p.col(i).head<3>().dot(fit.force_W);
+    chi2 += misfit * misfit / variance;
+  }
+  const double bound = dof + 4.0 * std::sqrt(2.0 * dof);
+  return chi2 > bound ? chi2 / dof : 1.0;
 }
 
 Matrix3 moment_at_point_covariance(const Matrix6& wrench, const Vector3& r_lp) noexcept {

@@ -120,6 +120,7 @@ class ContactEstimator {
   void track_drift(double t, const DetectionResult& det, const BaseWrench& base) noexcept;
   void uncertainty(int link, const WrenchFit& fit, std::uint32_t& flags) noexcept;
   void sensor_force_uncertainty() noexcept;
+  void partial_uncertainty(int link, const WrenchFit& fit, std::uint32_t& flags) noexcept;
 
   Status validate_sample(double t, const Eigen::Ref<const VectorX>& q,
                          const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau,

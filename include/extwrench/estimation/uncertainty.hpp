@@ -48,9 +48,27 @@ struct NoiseModel {
 ///   E  W̄ = A⁻¹ J τ̂, A = J Jᵀ + μ² I:                          Σ = A⁻¹ J Σ_τ Jᵀ A⁻¹ + bias
 /// bias = ‖x̂‖² μ⁴ A⁻², the second moment of the damping's bias −μ² A⁻¹ x with x taken as
 /// ‖x̂‖ in every direction (x̂ the solved unknowns). NaN when A cannot be factored.
+/// A partial fit (D, E: the minimum-norm solution on the observable subspace) takes for A⁻¹ the
+/// pseudo-inverse P = Σ_k v_k v_kᵀ / λ_k over the kept eigenvectors v_k of J Jᵀ (fit.basis_W) and
+/// has no damping bias: Σ is the observable part's, zero across the unobservable directions.
 [[nodiscard]] Matrix6 wrench_covariance(SensorType type, const Matrix6X& J, int link,
                                         const WrenchFit& fit, const NoiseModel& noise,
                                         const Vector3& r_sl) noexcept;
+
+/// Σ of the force of a known point without a sensor on a short chain (the partial fit of
+/// J_v,pᵀ F = τ̂, fit.basis_W's top-left block): P J_v,p Σ_τ J_v,pᵀ P, P the pseudo-inverse of
+/// J_v,p J_v,pᵀ on the observable subspace. In: J_p, the Jacobian of the point (6×n).
+[[nodiscard]] Matrix3 known_point_force_covariance(const Matrix6X& J_p, int link,
+                                                   const WrenchFit& fit,
+                                                   const NoiseModel& noise) noexcept;
+
+/// Whether the force alone at a known point explains the residual (the partial fit of
+/// known_point_force_covariance): χ² = Σ_{i≤l} (τ̂_i − J_v,p,iᵀ F̂)² / σ_i² on l − rank degrees of
+/// freedom. Returns χ²/(l − rank), the factor Σ_F grows by, when χ² exceeds
+/// (l − rank) + 4 √(2 (l − rank)) (about 0.5 % of consistent samples); 1 otherwise, and when
+/// l ≤ rank (nothing to refute it with).
+[[nodiscard]] double point_force_misfit(const Matrix6X& J_p, int link, const VectorX& tau_ext,
+                                        const WrenchFit& fit, const NoiseModel& noise) noexcept;
 
 /// Σ of M = M̄ − r_{l,p} × F (the moment at a known point) from Σ of (F; M̄).
 [[nodiscard]] Matrix3 moment_at_point_covariance(const Matrix6& wrench,

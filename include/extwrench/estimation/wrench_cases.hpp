@@ -30,6 +30,8 @@ struct WrenchFit {
   /// observable subspace (ok stays false: no line of action), basis_W its orthonormal basis in
   /// (F; M̄) coordinates, first `rank` columns.
   bool partial = false;
+  /// partial: the force alone at a known point (no sensor, J_v,pᵀ F = τ̂), basis_W's top-left.
+  bool point_force = false;
   int rank = 0;
   Eigen::Matrix<double, 6, 6> basis_W = Eigen::Matrix<double, 6, 6>::Zero();
 };
