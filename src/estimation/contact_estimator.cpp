@@ -68,6 +68,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   tau_eff_ = VectorX::Zero(n_);
   J_ = Matrix6X::Zero(6, n_);
   dforce_dddq_.setZero(3, n_);
+  dmoment_dddq_.setZero(3, n_);
   minv_jvt_.setZero(n_, 3);
   out_.residual = VectorX::Zero(n_);
   if (options_.drift) {

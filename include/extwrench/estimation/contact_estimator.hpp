@@ -165,7 +165,8 @@ class ContactEstimator {
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;
   Matrix6X J_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> dforce_dddq_;  ///< ∂f̃_g/∂q̈ (3×n), release force
-  Eigen::Matrix<double, Eigen::Dynamic, 3> minv_jvt_;     ///< B⁻¹ J_vᵀ (n×3), release force
+  Eigen::Matrix<double, 3, Eigen::Dynamic> dmoment_dddq_;  ///< ∂ñ_g/∂q̈ (3×n, about O_s), F/T
+  Eigen::Matrix<double, Eigen::Dynamic, 3> minv_jvt_;      ///< B⁻¹ J_vᵀ (n×3), release force
   ContactEstimate out_;
   // LDLᵀ of B(q) for q̈̂ with storage inside the object (up to kInlineJoints joints): the
   // fixed-capacity factorisation and solves are faster than the dynamic-size ones in Data.
