@@ -350,6 +350,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   flags |= detection_flags(det);
   if (options_.drift) track_drift(t, det, base);
   // 7. Isolation.
+  isolation_ = IsolationResult{};
   int link = isolate(det, options_.contact.model, options_.contact.link, flags);
   if (link >= 0 && isolation_rule_ == IsolationRule::kGeometry &&
       options_.contact.model == ContactModel::kPureForce && out_.status.ok()) {
@@ -435,8 +436,9 @@ int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& b
   in.tau_min = &detector_.thresholds();
   in.base = &base;
   in.p_WS = options_.sensor.X_WS.translation;
-  const IsolationResult r = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
-                                                options_.solver, isolation_ws_);
+  isolation_ = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
+                                   options_.solver, isolation_ws_);
+  const IsolationResult& r = isolation_;
   if (!r.decided) {
     flags |= EstimateFlag::kResidualIsolation;
     return residual_link;
@@ -518,7 +520,11 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
   } else if (fit.ok && contact) {
     if (line_of_action(fit, O_l, out_.line_point_W, out_.line_direction_W)) {
       flags |= EstimateFlag::kLineOfAction;
-      locate_on_surface(geometry_, link, X_WL, out_, flags, surface_normal_W_);
+      // Isolation met this very line with this link's shapes already (with an F/T sensor always:
+      // the same fit; case D or E unless the two solves' damping differed): take its entry.
+      const bool known = isolation_.has_entry_of(link, out_.line_point_W, out_.line_direction_W);
+      locate_on_surface(geometry_, link, X_WL, out_, flags, surface_normal_W_,
+                        known ? &isolation_.entry : nullptr);
     }
   }
 }

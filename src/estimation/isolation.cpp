@@ -26,10 +26,13 @@ bool predicts_residual(const Matrix6X& J, const WrenchFit& fit, const VectorX& t
   return true;
 }
 
-/// One tested candidate: where its line enters its shapes (abscissa u·p), or how far it misses.
+/// One tested candidate: its line and where it enters its shapes (abscissa u·p), if it does.
 struct CandidateHit {
   bool hit = false;
   double abscissa = kInf;  ///< u·p_entry [m]: smaller is met first by a pusher coming along u
+  Vector3 line_point_W = Vector3::Zero();
+  Vector3 line_direction_W = Vector3::Zero();
+  LineHit entry;
 };
 
 CandidateHit test_candidate(const Model& model, const Data& data, const GeometryModel& geometry,
@@ -46,7 +49,8 @@ CandidateHit test_candidate(const Model& model, const Data& data, const Geometry
   if (!fit.ok) return out;
   testable = true;
   if (!predicts_residual(ws.J, fit, *in.tau_ext, ws.tolerance, ws.tau_pred)) return out;
-  Vector3 p_W, u_W;
+  Vector3& p_W = out.line_point_W;
+  Vector3& u_W = out.line_direction_W;
   if (!line_of_action(fit, O_l, p_W, u_W)) return out;
   consistent = true;
   const SurfacePointResult res =
@@ -54,6 +58,7 @@ CandidateHit test_candidate(const Model& model, const Data& data, const Geometry
   if (res.hit) {
     out.hit = true;
     out.abscissa = u_W.dot(res.entry.point_W);
+    out.entry = res.entry;
   }
   return out;
 }
@@ -124,6 +129,9 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   if (best_link < 0) return res;
   res.link = best_link;
   res.decided = true;
+  res.line_point_W = best.line_point_W;
+  res.line_direction_W = best.line_direction_W;
+  res.entry = best.entry;
   for (int l = in.residual_link; l <= last; ++l) {
     if (l != best_link && abscissa[l] - best.abscissa <= options.ambiguity_distance)
       res.ambiguous = true;

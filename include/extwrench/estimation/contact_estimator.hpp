@@ -138,7 +138,8 @@ class ContactEstimator {
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
   IsolationWorkspace isolation_ws_;
-  NoiseModel noise_;  ///< options_.uncertainty as variances, the sensor's in W
+  IsolationResult isolation_;  ///< geometric isolation of the current sample (decided false: none)
+  NoiseModel noise_;           ///< options_.uncertainty as variances, the sensor's in W
   int n_ = 0;
   bool differentiation_ = false;  ///< route (a)
   bool need_ddq_ = false;         ///< q̈̂ needed: a sensor, or route (a)

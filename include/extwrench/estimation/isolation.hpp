@@ -21,6 +21,7 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/estimation/damped_least_squares.hpp"
+#include "extwrench/geometry/ray.hpp"
 #include "extwrench/geometry/shapes.hpp"
 #include "extwrench/model/model.hpp"
 
@@ -58,6 +59,17 @@ struct IsolationResult {
   bool ambiguous = false;        ///< another consistent entry within ambiguity_distance, or
                                  ///< a candidate below the chosen link that could not be tested
   bool decided = false;          ///< false: no candidate could be tested (paper's rule kept)
+  /// decided: the chosen link's line of action p̂ + λ u and where it enters the link's shapes,
+  /// so that localization need not intersect the same line with the same shapes again.
+  Vector3 line_point_W = Vector3::Zero();
+  Vector3 line_direction_W = Vector3::Zero();
+  LineHit entry;
+
+  /// True when `entry` is that of this very line (bit for bit) on `body`.
+  [[nodiscard]] bool has_entry_of(int body, const Vector3& point_W,
+                                  const Vector3& direction_W) const noexcept {
+    return decided && body == link && point_W == line_point_W && direction_W == line_direction_W;
+  }
 };
 
 /// Inputs of the geometric test, all of the current sample.
