@@ -96,6 +96,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   disagreement_on_ = false;
   have_disagreement_edge_ = false;
   spectrum_.size = 0;  // a reset run matches a fresh estimator's bit for bit
+  isolation_ws_.forget_spectra();
   release_link_ = -1;
   if (options_.sensor.tare_samples > 0) {
     tare_.bias_S.setZero();
@@ -350,7 +351,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   flags |= detection_flags(det);
   if (options_.drift) track_drift(t, det, base);
   // 7. Isolation.
-  isolation_ = IsolationResult{};
+  geometric_link_ = -1;
   int link = isolate(det, options_.contact.model, options_.contact.link, flags);
   if (link >= 0 && isolation_rule_ == IsolationRule::kGeometry &&
       options_.contact.model == ContactModel::kPureForce && out_.status.ok()) {
@@ -436,13 +437,13 @@ int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& b
   in.tau_min = &detector_.thresholds();
   in.base = &base;
   in.p_WS = options_.sensor.X_WS.translation;
-  isolation_ = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
-                                   options_.solver, isolation_ws_);
-  const IsolationResult& r = isolation_;
+  const IsolationResult r = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
+                                                options_.solver, isolation_ws_);
   if (!r.decided) {
     flags |= EstimateFlag::kResidualIsolation;
     return residual_link;
   }
+  geometric_link_ = r.link;
   out_.link_candidates = r.candidates & ~(std::uint64_t{1} << r.link);
   if (r.ambiguous) flags |= EstimateFlag::kAmbiguous;
   return r.link;
@@ -455,8 +456,12 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
                                            std::uint32_t& flags) noexcept {
   const Vector3& O_l = data_.X_WB[static_cast<std::size_t>(link)].translation;
   point_jacobian(model_, data_, link, O_l, J_);  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l
-  WrenchFit fit = wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
-                              options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
+  // Geometric isolation fitted this link already: the same case on the same J_l and τ̂ (cases D
+  // and E warm-started from this link's last solve rather than from the last link's).
+  WrenchFit fit = link == geometric_link_ ? isolation_ws_.tested[static_cast<std::size_t>(link)].fit
+                                          : wrench_case(options_.sensor.type, J_, link, tau_ext_,
+                                                        base, O_l, options_.sensor.X_WS.translation,
+                                                        options_.solver, b_, spectrum_);
   if (options_.sensor.type != SensorType::kForceTorque) out_.condition_number = fit.condition;
   if (fit.fitted_force) {
     out_.force_W = fit.force_W;
@@ -520,11 +525,12 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
   } else if (fit.ok && contact) {
     if (line_of_action(fit, O_l, out_.line_point_W, out_.line_direction_W)) {
       flags |= EstimateFlag::kLineOfAction;
-      // Isolation met this very line with this link's shapes already (with an F/T sensor always:
-      // the same fit; case D or E unless the two solves' damping differed): take its entry.
-      const bool known = isolation_.has_entry_of(link, out_.line_point_W, out_.line_direction_W);
+      // Geometric isolation met this very line with this link's shapes already: take its entry.
+      const TestedCandidate& c = isolation_ws_.tested[static_cast<std::size_t>(link)];
+      const bool known =
+          link == geometric_link_ && c.is_line(out_.line_point_W, out_.line_direction_W);
       locate_on_surface(geometry_, link, X_WL, out_, flags, surface_normal_W_,
-                        known ? &isolation_.entry : nullptr);
+                        known ? &c.entry : nullptr);
     }
   }
 }

@@ -138,8 +138,10 @@ class ContactEstimator {
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
   IsolationWorkspace isolation_ws_;
-  IsolationResult isolation_;  ///< geometric isolation of the current sample (decided false: none)
-  NoiseModel noise_;           ///< options_.uncertainty as variances, the sensor's in W
+  /// The link geometric isolation chose in this sample (its fit, line and entry are in
+  /// isolation_ws_.tested), −1: none.
+  int geometric_link_ = -1;
+  NoiseModel noise_;  ///< options_.uncertainty as variances, the sensor's in W
   int n_ = 0;
   bool differentiation_ = false;  ///< route (a)
   bool need_ddq_ = false;         ///< q̈̂ needed: a sensor, or route (a)
