@@ -96,6 +96,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   disagreement_on_ = false;
   have_disagreement_edge_ = false;
   spectrum_.size = 0;  // a reset run matches a fresh estimator's bit for bit
+  spectrum_link_ = -1;
   isolation_ws_.forget_spectra();
   release_link_ = -1;
   if (options_.sensor.tare_samples > 0) {
@@ -437,6 +438,10 @@ int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& b
   in.tau_min = &detector_.thresholds();
   in.base = &base;
   in.p_WS = options_.sensor.X_WS.translation;
+  // The candidate that stage 8 solved last starts from stage 8's warm start: if it is chosen
+  // again, its fit is then the very solve stage 8 would make (table_one_case takes it over).
+  if (spectrum_link_ >= 0)
+    isolation_ws_.guess[static_cast<std::size_t>(spectrum_link_)] = spectrum_;
   const IsolationResult r = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
                                                 options_.solver, isolation_ws_);
   if (!r.decided) {
@@ -456,12 +461,15 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
                                            std::uint32_t& flags) noexcept {
   const Vector3& O_l = data_.X_WB[static_cast<std::size_t>(link)].translation;
   point_jacobian(model_, data_, link, O_l, J_);  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l
-  // Geometric isolation fitted this link already: the same case on the same J_l and τ̂ (cases D
-  // and E warm-started from this link's last solve rather than from the last link's).
-  WrenchFit fit = link == geometric_link_ ? isolation_ws_.tested[static_cast<std::size_t>(link)].fit
-                                          : wrench_case(options_.sensor.type, J_, link, tau_ext_,
-                                                        base, O_l, options_.sensor.X_WS.translation,
-                                                        options_.solver, b_, spectrum_);
+  // Geometric isolation made this very solve already (same J_l, τ̂ and warm start): take it over.
+  const auto l = static_cast<std::size_t>(link);
+  const bool solved = link == geometric_link_ && link == spectrum_link_;
+  WrenchFit fit =
+      solved ? isolation_ws_.tested[l].fit
+             : wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
+                           options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
+  if (solved) spectrum_ = isolation_ws_.guess[l];
+  spectrum_link_ = link;
   if (options_.sensor.type != SensorType::kForceTorque) out_.condition_number = fit.condition;
   if (fit.fitted_force) {
     out_.force_W = fit.force_W;
