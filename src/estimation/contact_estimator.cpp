@@ -97,6 +97,8 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   disagreement_on_ = false;
   have_disagreement_edge_ = false;
   spectrum_.size = 0;  // a reset run matches a fresh estimator's bit for bit
+  spectrum_link_ = -1;
+  isolation_ws_.forget_spectra();
   release_link_ = -1;
   if (options_.sensor.tare_samples > 0) {
     tare_.bias_S.setZero();
@@ -351,6 +353,7 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   flags |= detection_flags(det);
   if (options_.drift) track_drift(t, det, base);
   // 7. Isolation.
+  geometric_link_ = -1;
   int link = isolate(det, options_.contact.model, options_.contact.link, flags);
   if (link >= 0 && isolation_rule_ == IsolationRule::kGeometry &&
       options_.contact.model == ContactModel::kPureForce && out_.status.ok()) {
@@ -436,12 +439,17 @@ int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& b
   in.tau_min = &detector_.thresholds();
   in.base = &base;
   in.p_WS = options_.sensor.X_WS.translation;
+  // The candidate that stage 8 solved last starts from stage 8's warm start: if it is chosen
+  // again, its fit is then the very solve stage 8 would make (table_one_case takes it over).
+  if (spectrum_link_ >= 0)
+    isolation_ws_.guess[static_cast<std::size_t>(spectrum_link_)] = spectrum_;
   const IsolationResult r = isolate_on_geometry(model_, data_, geometry_, in, options_.isolation,
                                                 options_.solver, isolation_ws_);
   if (!r.decided) {
     flags |= EstimateFlag::kResidualIsolation;
     return residual_link;
   }
+  geometric_link_ = r.link;
   out_.link_candidates = r.candidates & ~(std::uint64_t{1} << r.link);
   if (r.ambiguous) flags |= EstimateFlag::kAmbiguous;
   return r.link;
@@ -454,8 +462,15 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
                                            std::uint32_t& flags) noexcept {
   const Vector3& O_l = data_.X_WB[static_cast<std::size_t>(link)].translation;
   point_jacobian(model_, data_, link, O_l, J_);  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l
-  WrenchFit fit = wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
-                              options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
+  // Geometric isolation made this very solve already (same J_l, τ̂ and warm start): take it over.
+  const auto l = static_cast<std::size_t>(link);
+  const bool solved = link == geometric_link_ && link == spectrum_link_;
+  WrenchFit fit =
+      solved ? isolation_ws_.tested[l].fit
+             : wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
+                           options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
+  if (solved) spectrum_ = isolation_ws_.guess[l];
+  spectrum_link_ = link;
   if (options_.sensor.type != SensorType::kForceTorque) out_.condition_number = fit.condition;
   if (fit.fitted_force) {
     out_.force_W = fit.force_W;
@@ -523,7 +538,12 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
   } else if (fit.ok && contact) {
     if (line_of_action(fit, O_l, out_.line_point_W, out_.line_direction_W)) {
       flags |= EstimateFlag::kLineOfAction;
-      locate_on_surface(geometry_, link, X_WL, out_, flags, surface_normal_W_);
+      // Geometric isolation met this very line with this link's shapes already: take its entry.
+      const TestedCandidate& c = isolation_ws_.tested[static_cast<std::size_t>(link)];
+      const bool known =
+          link == geometric_link_ && c.is_line(out_.line_point_W, out_.line_direction_W);
+      locate_on_surface(geometry_, link, X_WL, out_, flags, surface_normal_W_,
+                        known ? &c.entry : nullptr);
     }
   }
 }

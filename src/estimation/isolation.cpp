@@ -41,19 +41,22 @@ CandidateHit test_candidate(const Model& model, const Data& data, const Geometry
   const Pose& X_WL = data.X_WB[static_cast<std::size_t>(l)];
   const Vector3& O_l = X_WL.translation;
   point_jacobian(model, data, l, O_l, ws.J);
-  const WrenchFit fit = wrench_case(in.sensor, ws.J, l, *in.tau_ext, *in.base, O_l, in.p_WS, solver,
-                                    ws.b, ws.guess[static_cast<std::size_t>(l)], false);
-  if (!fit.ok) return out;
+  TestedCandidate& t = ws.tested[static_cast<std::size_t>(l)];
+  t.fit = wrench_case(in.sensor, ws.J, l, *in.tau_ext, *in.base, O_l, in.p_WS, solver, ws.b,
+                      ws.guess[static_cast<std::size_t>(l)], false);
+  if (!t.fit.ok) return out;
   testable = true;
-  if (!predicts_residual(ws.J, fit, *in.tau_ext, ws.tolerance, ws.tau_pred)) return out;
-  Vector3 p_W, u_W;
-  if (!line_of_action(fit, O_l, p_W, u_W)) return out;
+  if (!predicts_residual(ws.J, t.fit, *in.tau_ext, ws.tolerance, ws.tau_pred)) return out;
+  const Vector3& p_W = t.line_point_W;
+  const Vector3& u_W = t.line_direction_W;
+  if (!line_of_action(t.fit, O_l, t.line_point_W, t.line_direction_W)) return out;
   consistent = true;
   const SurfacePointResult res =
       intersect_line_with_body(geometry, l, X_WL, p_W, u_W, OnMiss::kNothing);
   if (res.hit) {
     out.hit = true;
     out.abscissa = u_W.dot(res.entry.point_W);
+    t.entry = res.entry;
   }
   return out;
 }
@@ -83,7 +86,12 @@ IsolationWorkspace::IsolationWorkspace(const Model& model)
       b(VectorX::Zero(model.nq())),
       tau_pred(VectorX::Zero(model.nq())),
       tolerance(VectorX::Zero(model.nq())),
-      guess(static_cast<std::size_t>(model.num_bodies())) {}
+      guess(static_cast<std::size_t>(model.num_bodies())),
+      tested(static_cast<std::size_t>(model.num_bodies())) {}
+
+void IsolationWorkspace::forget_spectra() noexcept {
+  for (SpectrumGuess& g : guess) g.size = 0;
+}
 
 IsolationResult isolate_on_geometry(const Model& model, const Data& data,
                                     const GeometryModel& geometry, const IsolationInputs& in,

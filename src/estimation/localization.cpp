@@ -7,14 +7,20 @@
 namespace extwrench {
 
 void locate_on_surface(const GeometryModel& geometry, int link, const Pose& X_WL,
-                       ContactEstimate& out, std::uint32_t& flags, Vector3& normal_W) noexcept {
+                       ContactEstimate& out, std::uint32_t& flags, Vector3& normal_W,
+                       const LineHit* known_entry) noexcept {
   const auto l = static_cast<std::size_t>(link);
   if (geometry.body_shapes[l].empty()) {
     flags |= EstimateFlag::kNoGeometry;
     return;
   }
-  const SurfacePointResult res =
-      intersect_line_with_body(geometry, link, X_WL, out.line_point_W, out.line_direction_W);
+  SurfacePointResult res;
+  if (known_entry != nullptr) {
+    res.hit = true;
+    res.entry = *known_entry;
+  } else {
+    res = intersect_line_with_body(geometry, link, X_WL, out.line_point_W, out.line_direction_W);
+  }
   if (res.hit) {
     out.point_W = res.entry.point_W;  // smallest λ: the pushing point (21)
     out.surface_distance = 0.0;

@@ -139,6 +139,9 @@ class ContactEstimator {
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
   IsolationWorkspace isolation_ws_;
+  /// The link geometric isolation chose in this sample (its fit, line and entry are in
+  /// isolation_ws_.tested), −1: none.
+  int geometric_link_ = -1;
   NoiseModel noise_;  ///< options_.uncertainty as variances, the sensor's in W
   int n_ = 0;
   bool differentiation_ = false;  ///< route (a)
@@ -159,6 +162,7 @@ class ContactEstimator {
   double drift_quiet_since_ = 0.0;             ///< last sample with contact, pending or raw [s]
   double drift_t_prev_ = 0.0;
   SpectrumGuess spectrum_;  ///< of J Jᵀ at the last damped solve (cases D, E); size 0 after reset
+  int spectrum_link_ = -1;  ///< the link of that solve (stage 8's last), −1 after reset
   Vector3 surface_normal_W_ = Vector3::Zero();  ///< outward normal at the surface point (stage 9)
 
   // Scratch, sized once.

@@ -21,6 +21,8 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/estimation/damped_least_squares.hpp"
+#include "extwrench/estimation/wrench_cases.hpp"
+#include "extwrench/geometry/ray.hpp"
 #include "extwrench/geometry/shapes.hpp"
 #include "extwrench/model/model.hpp"
 
@@ -44,12 +46,32 @@ struct IsolationOptions {
 [[nodiscard]] IsolationRule resolved_rule(const IsolationOptions& options,
                                           const GeometryModel& geometry) noexcept;
 
+/// What isolate_on_geometry found for one candidate link in its last call: the estimator's
+/// later stages take it over for the chosen link instead of computing it again.
+struct TestedCandidate {
+  WrenchFit fit;  ///< its Table I fit (ok: the case is observable on the link)
+  /// Consistent candidates: the line of action p̂ + λ u, and (when the line meets the link's
+  /// shapes) its entry, the smallest-λ hit.
+  Vector3 line_point_W = Vector3::Zero();
+  Vector3 line_direction_W = Vector3::Zero();
+  LineHit entry;
+
+  /// True when `entry` was computed for this very line (bit for bit).
+  [[nodiscard]] bool is_line(const Vector3& point_W, const Vector3& direction_W) const noexcept {
+    return point_W == line_point_W && direction_W == line_direction_W;
+  }
+};
+
 /// Scratch of isolate_on_geometry, sized once for a model (the only allocations).
 struct IsolationWorkspace {
   explicit IsolationWorkspace(const Model& model);
-  Matrix6X J;                        ///< J_l of a candidate, 6×n
-  VectorX b, tau_pred, tolerance;    ///< (n)
-  std::vector<SpectrumGuess> guess;  ///< per candidate link: warm start of the damped solves
+  Matrix6X J;                           ///< J_l of a candidate, 6×n
+  VectorX b, tau_pred, tolerance;       ///< (n)
+  std::vector<SpectrumGuess> guess;     ///< per candidate link: warm start of the damped solves
+  std::vector<TestedCandidate> tested;  ///< per link: valid for the chosen link of the last call
+
+  /// Forgets the warm starts (a reset estimator then matches a fresh one bit for bit).
+  void forget_spectra() noexcept;
 };
 
 struct IsolationResult {
@@ -57,7 +79,8 @@ struct IsolationResult {
   std::uint64_t candidates = 0;  ///< bit l: link l consistent (the chosen one included)
   bool ambiguous = false;        ///< another consistent entry within ambiguity_distance, or
                                  ///< a candidate below the chosen link that could not be tested
-  bool decided = false;          ///< false: no candidate could be tested (paper's rule kept)
+  bool decided = false;          ///< false: no candidate could be tested (paper's rule kept);
+                                 ///< true: ws.tested[link] holds the chosen link's fit and entry
 };
 
 /// Inputs of the geometric test, all of the current sample.
