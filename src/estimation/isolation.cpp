@@ -14,14 +14,18 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 /// True when the single wrench (F̂, M̄) on the candidate reproduces τ̂_ext on every joint within
-/// its tolerance (zero torque expected beyond the candidate: J is zero there).
+/// its tolerance (zero torque expected beyond the candidate: J is zero there). `misfit`:
+/// Σ_i ((τ_pred,i − τ̂_i)/tolerance_i)², how well it does.
 bool predicts_residual(const Matrix6X& J, const WrenchFit& fit, const VectorX& tau_ext,
-                       const VectorX& tolerance, VectorX& tau_pred) noexcept {
+                       const VectorX& tolerance, VectorX& tau_pred, double& misfit) noexcept {
   Vector6 w;
   w << fit.force_W, fit.moment_O;
   tau_pred.noalias() = J.transpose() * w;
+  misfit = 0.0;
   for (Eigen::Index i = 0; i < tau_pred.size(); ++i) {
-    if (!(std::abs(tau_pred[i] - tau_ext[i]) <= tolerance[i])) return false;
+    const double e = std::abs(tau_pred[i] - tau_ext[i]);
+    if (!(e <= tolerance[i])) return false;
+    misfit += (e / tolerance[i]) * (e / tolerance[i]);
   }
   return true;
 }
@@ -30,6 +34,7 @@ bool predicts_residual(const Matrix6X& J, const WrenchFit& fit, const VectorX& t
 struct CandidateHit {
   bool hit = false;
   double abscissa = kInf;  ///< u·p_entry [m]: smaller is met first by a pusher coming along u
+  double misfit = kInf;    ///< of its residual prediction (predicts_residual)
 };
 
 CandidateHit test_candidate(const Model& model, const Data& data, const GeometryModel& geometry,
@@ -46,7 +51,8 @@ CandidateHit test_candidate(const Model& model, const Data& data, const Geometry
                       ws.guess[static_cast<std::size_t>(l)], false);
   if (!t.fit.ok) return out;
   testable = true;
-  if (!predicts_residual(ws.J, t.fit, *in.tau_ext, ws.tolerance, ws.tau_pred)) return out;
+  if (!predicts_residual(ws.J, t.fit, *in.tau_ext, ws.tolerance, ws.tau_pred, out.misfit))
+    return out;
   const Vector3& p_W = t.line_point_W;
   const Vector3& u_W = t.line_direction_W;
   if (!line_of_action(t.fit, O_l, t.line_point_W, t.line_direction_W)) return out;
@@ -107,12 +113,13 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   CandidateHit best;
   int best_link = -1;
   // Abscissae of the consistent hits, to judge ambiguity once the best is known.
-  double abscissa[64];
+  double abscissa[64], misfit[64];
   // The lowest candidate with shapes whose case is not observable (it could hold the contact but
   // cannot be tested: without a sensor, a link with fewer than six joints before it).
   int lowest_untested = last + 1;
   for (int l = in.residual_link; l <= last; ++l) {
     abscissa[l] = kInf;
+    misfit[l] = kInf;
     if (geometry.body_shapes[static_cast<std::size_t>(l)].empty()) continue;
     bool testable = false, consistent = false;
     const CandidateHit c =
@@ -122,6 +129,7 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
     res.candidates |= std::uint64_t{1} << l;
     if (c.hit) {
       abscissa[l] = c.abscissa;
+      misfit[l] = c.misfit;
       if (!best.hit || c.abscissa < best.abscissa) {
         best = c;
         best_link = l;
@@ -130,12 +138,16 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   }
   // No consistent line meets a candidate's shapes: geometry has no say, the paper's rule stands.
   if (best_link < 0) return res;
+  // Entries within ambiguity_distance of the first are equally good as geometry goes (the lines
+  // carry errors of that order): among them the candidate that explains τ̂ best.
+  const double first = best.abscissa;
+  for (int l = in.residual_link; l <= last; ++l) {
+    if (l == best_link || !(abscissa[l] - first <= options.ambiguity_distance)) continue;
+    res.ambiguous = true;
+    if (misfit[l] < misfit[best_link]) best_link = l;
+  }
   res.link = best_link;
   res.decided = true;
-  for (int l = in.residual_link; l <= last; ++l) {
-    if (l != best_link && abscissa[l] - best.abscissa <= options.ambiguity_distance)
-      res.ambiguous = true;
-  }
   // A link below the chosen one could not be tested: it may hold the contact as well (a push on
   // the paper arm's link 4 without a sensor fits a force on link 6 within tolerance).
   if (lowest_untested < best_link) res.ambiguous = true;

@@ -252,9 +252,9 @@ TEST(MujocoPushes, PandaMeshesFindThePushedLinkAndPoint) {
 }
 
 TEST(MujocoPushes, PaperArmCapsulesFindThePushedLinkAndPoint) {
-  // Not met: force sensor 91.8 % (links 6-7 87-90 %), no sensor 85.4 %, release 65 % within 5 ms.
+  // Not met: no sensor 87.1 % (links 6 and 7 confused where both are consistent and their
+  // entries lie within 1 cm), release 64 % within 5 ms.
   Bounds bounds;
-  bounds.right[1] = 0.90;
   bounds.right[2] = 0.85;
   bounds.released_5ms = 0.6;
   acceptance(test::project_models() / "paper_arm.xml", 2, 9102, bounds);
