@@ -218,6 +218,17 @@ void ContactEstimator::momentum_and_bias_terms_stage(const Eigen::Ref<const Vect
   }
 }
 
+// Backward difference of q̇ through a first-order low-pass (cutoff f_c), exact discretization
+// for the actual Δt, into ddq_filtered_.
+void ContactEstimator::differentiate_velocity(double dt,
+                                              const Eigen::Ref<const VectorX>& dq) noexcept {
+  const double a = std::exp(-2.0 * std::numbers::pi * options_.differentiation_cutoff * dt);
+  for (int i = 0; i < n_; ++i) {
+    const double raw = (dq[i] - dq_prev_[i]) / dt;
+    ddq_filtered_[i] = a * ddq_filtered_[i] + (1.0 - a) * raw;
+  }
+}
+
 // 3. In: Δt, q̇, τ, r and τ_f (observer), data_ of stage 1. Out: tau_eff_ = τ − τ_f, ddq_ = q̈̂
 // (NaN when not needed or singular), data_.M with route (b); kSingular when B(q) cannot be
 // factored.
@@ -225,13 +236,7 @@ Status ContactEstimator::acceleration_route(double dt, const Eigen::Ref<const Ve
                                             const Eigen::Ref<const VectorX>& tau) noexcept {
   tau_eff_ = tau - observer_.friction_torque();  // τ − τ_f
   if (differentiation_) {
-    // (a) q̈̂: backward difference of q̇ through a first-order low-pass (cutoff f_c), exact
-    // discretization for the actual Δt.
-    const double a = std::exp(-2.0 * std::numbers::pi * options_.differentiation_cutoff * dt);
-    for (int i = 0; i < n_; ++i) {
-      const double raw = (dq[i] - dq_prev_[i]) / dt;
-      ddq_filtered_[i] = a * ddq_filtered_[i] + (1.0 - a) * raw;
-    }
+    differentiate_velocity(dt, dq);  // (a) q̈̂
     ddq_ = ddq_filtered_;
     return Status::success();
   }
@@ -239,6 +244,9 @@ Status ContactEstimator::acceleration_route(double dt, const Eigen::Ref<const Ve
     ddq_.setConstant(kNaN);
     return Status::success();
   }
+  // With a base sensor the differentiated q̇ is kept too: the release falls back on it where the
+  // sensor alone cannot tell the force (sensor_release.cpp).
+  differentiate_velocity(dt, dq);
   // (b) q̈̂ = B⁻¹ (τ − τ_f + r − c(q, q̇)): forward dynamics with τ + r. The kinematics of q and
   // c = C q̇ + g (data_.tau) are already in data_ (stage 1).
   crba_no_kinematics(model_, data_);

@@ -1,7 +1,9 @@
 // Release from the base sensor (docs/estimator.md#release-from-the-sensor): stage 5b of
 // ContactEstimator::update, apart from the stages so that detection and isolation stay short.
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
@@ -23,6 +25,7 @@ namespace extwrench {
 // through its filter.
 double ContactEstimator::sensor_release_force(const BaseWrench& base) noexcept {
   constexpr double kMinConditionInverse = 1e-3;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
   if (differentiation_) return base.force_W.norm();
   if (!out_.status.ok() || !base.force_W.allFinite()) return ContactDetector::kNoReleaseForce;
   const Pose& X_WL = data_.X_WB[static_cast<std::size_t>(release_link_)];
@@ -71,12 +74,24 @@ double ContactEstimator::sensor_release_force(const BaseWrench& base) noexcept {
   // 3×3 by cofactors; 1/κ_F = 1/(‖A‖_F ‖A⁻¹‖_F) ≤ σ_min/σ_max judges the conditioning (of the
   // normal matrix: its square).
   const double det = A.determinant();
-  if (!std::isfinite(det) || det == 0.0) return ContactDetector::kNoReleaseForce;
   const Matrix3 A_inv = A.inverse();
   const double min_inverse =
       moments ? kMinConditionInverse * kMinConditionInverse : kMinConditionInverse;
-  if (!(1.0 / (A.norm() * A_inv.norm()) > min_inverse)) return ContactDetector::kNoReleaseForce;
-  return (A_inv * y).norm();
+  const double predicted =
+      std::isfinite(det) && det != 0.0 && 1.0 / (A.norm() * A_inv.norm()) > min_inverse
+          ? (A_inv * y).norm()
+          : kInf;
+  // The force with q̈ measured instead (q̇ differentiated, low-passed at differentiation_cutoff):
+  // F̂(q̈̃) = F̂ − G (q̈̃ − q̈̂). It lags by the filter but does not depend on how well the base
+  // feels the push through q̈_free. Either below the release level for min_duration releases:
+  // while the push lasts both see it.
+  double measured = kInf;
+  if (ddq_.allFinite() && ddq_filtered_.allFinite()) {
+    b_ = ddq_filtered_ - ddq_;
+    measured = (base.force_W - dforce_dddq_ * b_).norm();
+  }
+  const double force = std::min(predicted, measured);
+  return std::isfinite(force) ? force : ContactDetector::kNoReleaseForce;
 }
 
 }  // namespace extwrench

@@ -112,6 +112,7 @@ class ContactEstimator {
   BaseWrench base_sensor_reading(const Vector6& reading_S, std::uint32_t& flags) noexcept;
   WrenchFit table_one_case(int link, const BaseWrench& base, std::uint32_t& flags) noexcept;
   double sensor_release_force(const BaseWrench& base) noexcept;
+  void differentiate_velocity(double dt, const Eigen::Ref<const VectorX>& dq) noexcept;
   void known_point_force(int link, WrenchFit& fit, std::uint32_t& flags) noexcept;
   int geometric_isolation(int residual_link, const BaseWrench& base, std::uint32_t& flags) noexcept;
   void contact_point(int link, const WrenchFit& fit, bool contact, std::uint32_t& flags) noexcept;
@@ -151,7 +152,7 @@ class ContactEstimator {
   // State besides the observer's.
   bool initialized_ = false;
   double t_ = 0.0;
-  VectorX dq_prev_, ddq_filtered_;  ///< route (a)
+  VectorX dq_prev_, ddq_filtered_;  ///< route (a); with a base sensor, the release too
   bool have_dq_prev_ = false;
   SensorTare tare_;
   bool disagreement_on_ = false, have_disagreement_edge_ = false;
