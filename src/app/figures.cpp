@@ -260,7 +260,7 @@ void FigureRecorder::estimate_columns(const Sample& s, const ContactEstimate& e,
   r[kCondEstimated] = kNaN;
   // On a log without truth, the contact link's conditioning is still worth seeing.
   if (!truth_ && e.contact && e.link > 0 && s.q.size() == model_.nq()) {
-    forward_kinematics(model_, data_, s.q);
+    forward_poses(model_, data_, s.q);  // all jacobian_condition needs
     r[kCondEstimated] = jacobian_condition(model_, data_, e.link);
   }
 }
@@ -275,7 +275,7 @@ void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, do
   r[kCondTrue] = kNaN;
   // Every row (not only kept ones): the envelope keeps the singular peak (Fig. 10).
   if (truth_ && s.truth.body > 0) {
-    forward_kinematics(model_, data_, s.q);
+    forward_poses(model_, data_, s.q);  // all jacobian_condition needs
     r[kCondTrue] = jacobian_condition(model_, data_, s.truth.body);
   }
   r[kErrF] = kNaN;

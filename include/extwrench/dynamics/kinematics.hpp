@@ -37,8 +37,9 @@ const Matrix6X& body_jacobian(const Model& model, Data& data, int body);
 
 /// cond(J) = σ_max / σ_min of J (6 × l), the Jacobian of the origin O_l of body l, world frame,
 /// SI units: the "condition number of J of O_6" of the paper's Fig. 10 when l = 6. After
-/// forward_kinematics; NaN for body <= 0, +inf when J is singular. Allocates (an SVD): not for
-/// the real-time path.
+/// forward_poses (or forward_kinematics); NaN for body <= 0, +inf when J is singular. From the
+/// eigenvalues of J's Gram matrix while κ < 1e6, else (and beyond 64 joints) from an SVD, which
+/// allocates: not for the real-time path.
 [[nodiscard]] double jacobian_condition(const Model& model, const Data& data, int body);
 
 }  // namespace extwrench
