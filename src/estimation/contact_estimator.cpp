@@ -352,11 +352,12 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   if (has_sensor) base = base_sensor_reading(reading_S, flags);  // 5
   // 6. Detection.
   const double base_force = has_sensor && !base.taring ? base.force_W.norm() : kNaN;
-  const double release_force = has_sensor && !base.taring && release_link_ >= 0
-                                   ? sensor_release_force(base)
-                                   : ContactDetector::kNoReleaseForce;
+  const ReleaseForces release = has_sensor && !base.taring && release_link_ >= 0
+                                    ? sensor_release_forces(base)
+                                    : ReleaseForces{};
   detector_.set_motion(dq);  // thresholds that follow |q̇| (no-op when constant)
-  const DetectionResult& det = detector_.update(t, tau_ext_, base_force, release_force);
+  const DetectionResult& det =
+      detector_.update(t, tau_ext_, base_force, release.either, release.measured);
   out_.contact = det.contact;
   flags |= detection_flags(det);
   if (options_.drift) track_drift(t, det, base);

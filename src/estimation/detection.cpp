@@ -44,6 +44,9 @@ void validate(const DetectionOptions& options, int n) {
   if (!std::isfinite(options.min_duration) || options.min_duration < 0.0) {
     throw Error("detection.min_duration: expected a finite value >= 0 [s]");
   }
+  if (!std::isfinite(options.sensor_release_duration) || options.sensor_release_duration < 0.0) {
+    throw Error("detection.sensor_release_duration: expected a finite value >= 0 [s]");
+  }
 }
 
 ContactDetector::ContactDetector(const DetectionOptions& options, int n, double release_settle_time)
@@ -78,8 +81,8 @@ void ContactDetector::reset() noexcept {
 }
 
 const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const VectorX>& tau_ext,
-                                               double base_force_norm,
-                                               double release_force_norm) noexcept {
+                                               double base_force_norm, double release_force_norm,
+                                               double measured_release_force_norm) noexcept {
   const double ratio = options_.release_ratio;
   int link = -1;
   for (Eigen::Index i = 0; i < threshold_.size(); ++i) {
@@ -100,9 +103,12 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
   const bool over = raw;
   if (!over) sensor_release_disproved_ = false;
   // The sensor says the force is gone: release without waiting for the residual's decay.
+  bool sensor_off = false;
   if (declared_ && !sensor_release_disproved_ && std::isfinite(release_force_norm) &&
       !(release_force_norm > ratio * options_.f_min)) {
     raw = false;
+    sensor_off = std::isfinite(measured_release_force_norm) &&
+                 !(measured_release_force_norm > ratio * options_.f_min);
   }
   if (rearm_) {  // after a sensor release, a new onset needs every threshold to have dropped
     if (!over) {
@@ -117,13 +123,15 @@ const DetectionResult& ContactDetector::update(double t, const Eigen::Ref<const 
     }
   }
 
-  // Debounce both edges: the raw state must hold for min_duration before it is declared.
+  // Debounce both edges: the raw state must hold for min_duration before it is declared; a
+  // release the measured-q̈ force confirms (now) for sensor_release_duration.
   if (raw != declared_) {
     if (!have_edge_) {
       have_edge_ = true;
       edge_time_ = t;
     }
-    if (t - edge_time_ >= options_.min_duration - kTimeSlack) {
+    const double hold = sensor_off ? options_.sensor_release_duration : options_.min_duration;
+    if (t - edge_time_ >= hold - kTimeSlack) {
       declared_ = raw;
       have_edge_ = false;
       if (!raw && over) {

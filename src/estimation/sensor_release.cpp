@@ -23,11 +23,12 @@ namespace extwrench {
 // does not feel the push at first, its moment still does. NaN when the system is
 // ill-conditioned or B is not factored. Route (a) differentiates q̇: F̂ itself follows the force,
 // through its filter.
-double ContactEstimator::sensor_release_force(const BaseWrench& base) noexcept {
+ContactEstimator::ReleaseForces ContactEstimator::sensor_release_forces(
+    const BaseWrench& base) noexcept {
   constexpr double kMinConditionInverse = 1e-3;
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  if (differentiation_) return base.force_W.norm();
-  if (!out_.status.ok() || !base.force_W.allFinite()) return ContactDetector::kNoReleaseForce;
+  if (differentiation_) return {base.force_W.norm(), base.force_W.norm()};
+  if (!out_.status.ok() || !base.force_W.allFinite()) return {};
   const Pose& X_WL = data_.X_WB[static_cast<std::size_t>(release_link_)];
   const Vector3 p_W = X_WL.act(release_point_L_);
   point_jacobian(model_, data_, release_link_, p_W, J_);
@@ -83,15 +84,20 @@ double ContactEstimator::sensor_release_force(const BaseWrench& base) noexcept {
           : kInf;
   // The force with q̈ measured instead (q̇ differentiated, low-passed at differentiation_cutoff):
   // F̂(q̈̃) = F̂ − G (q̈̃ − q̈̂). It lags by the filter but does not depend on how well the base
-  // feels the push through q̈_free. Either below the release level for min_duration releases:
-  // while the push lasts both see it.
+  // feels the push through q̈_free, nor on the isolated link and point. Either below the release
+  // level for min_duration releases: while the push lasts both see it. The measured one below it
+  // releases after sensor_release_duration: the predicted one alone can dip with a model error
+  // amplified by an ill-conditioned system or a wrong point (a collision's first milliseconds).
   double measured = kInf;
   if (ddq_.allFinite() && ddq_filtered_.allFinite()) {
     b_ = ddq_filtered_ - ddq_;
     measured = (base.force_W - dforce_dddq_ * b_).norm();
   }
-  const double force = std::min(predicted, measured);
-  return std::isfinite(force) ? force : ContactDetector::kNoReleaseForce;
+  const double either = std::min(predicted, measured);
+  ReleaseForces out;
+  if (std::isfinite(either)) out.either = either;
+  if (std::isfinite(measured)) out.measured = measured;
+  return out;
 }
 
 }  // namespace extwrench

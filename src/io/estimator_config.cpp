@@ -64,7 +64,8 @@ void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorO
 
 void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionOptions& o) {
   rd.only_keys(d, "detection",
-               {"tau_min", "tau_per_speed", "f_min", "release_ratio", "min_duration"});
+               {"tau_min", "tau_per_speed", "f_min", "release_ratio", "min_duration",
+                "sensor_release_duration"});
   const Range tau_min = positive();
   if (d["tau_min"]) o.tau_min = rd.vector(d["tau_min"], "detection.tau_min", n, &tau_min);
   const Range per_speed = io_detail::non_negative(">= 0 [N m s/rad]");
@@ -73,6 +74,8 @@ void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionO
   rd.set_number_in(d, "detection", "f_min", {0, 1e12, true, "> 0 [N]"}, o.f_min);
   rd.set_number_in(d, "detection", "release_ratio", {0, 1, true, "in (0, 1]"}, o.release_ratio);
   rd.set_number_in(d, "detection", "min_duration", {0, 1e6, false, ">= 0 [s]"}, o.min_duration);
+  rd.set_number_in(d, "detection", "sensor_release_duration", {0, 1e6, false, ">= 0 [s]"},
+                   o.sensor_release_duration);
 }
 
 // Either a route (acceleration: residual) or a mapping {route, cutoff}.
@@ -411,7 +414,8 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   if ((o.detection.tau_per_speed.array() > 0.0).any())
     y << "\n  tau_per_speed: " << io_detail::yaml_list(o.detection.tau_per_speed);
   y << "\n  f_min: " << o.detection.f_min << "\n  release_ratio: " << o.detection.release_ratio
-    << "\n  min_duration: " << o.detection.min_duration << '\n';
+    << "\n  min_duration: " << o.detection.min_duration
+    << "\n  sensor_release_duration: " << o.detection.sensor_release_duration << '\n';
   y << "acceleration: {route: " << to_string(o.acceleration)
     << ", cutoff: " << o.differentiation_cutoff << "}\n";
   if (o.friction) {

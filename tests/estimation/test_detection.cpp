@@ -26,8 +26,9 @@ struct ReleaseRun {
   double released_at = NAN;    ///< first release after kForceOff [s]
 };
 
-ReleaseRun run_detector(double level, bool force_ends) {
-  DetectionOptions options;  // τ_min 1, F_min 5, ratio 0.5, min_duration 5 ms
+/// `measured`: what the force with q̈ measured reads after kForceOff (NaN: not given).
+ReleaseRun run_detector(double level, bool force_ends, double measured = NAN) {
+  DetectionOptions options;  // τ_min 1, F_min 5, ratio 0.5, min_duration 5 ms, sensor release 1 ms
   ContactDetector detector(options, kJoints, kSettle);
   ReleaseRun out;
   bool was = false;
@@ -39,7 +40,9 @@ ReleaseRun run_detector(double level, bool force_ends) {
     tau_ext[1] = size * options.tau_min[0];
     const double base_force = size * options.f_min;
     const double release_force = t < 0.1 ? NAN : (t > kForceOff ? 0.0 : base_force);
-    const DetectionResult& det = detector.update(t, tau_ext, base_force, release_force);
+    const double measured_force = t > kForceOff ? measured : release_force;
+    const DetectionResult& det =
+        detector.update(t, tau_ext, base_force, release_force, measured_force);
     if (det.contact && !was) ++out.onsets;
     if (!det.contact && was && t > kForceOff && std::isnan(out.released_at)) out.released_at = t;
     if (det.contact && t > kForceOff + 0.02) ++out.declared_after_off;
@@ -54,6 +57,21 @@ TEST(Detection, ASensorReleaseTheResidualConfirmsStaysReleased) {
     EXPECT_EQ(r.onsets, 1) << level;
     EXPECT_NEAR(r.released_at, kForceOff + 0.005, 1.5e-3) << level;  // min_duration
     EXPECT_EQ(r.declared_after_off, 0) << level;
+  }
+}
+
+// The force with q̈ measured assumes no contact point: when it agrees that the force is gone the
+// release waits sensor_release_duration (1 ms: the second sample below the level), not
+// min_duration; when it still reads the push (the point-dependent force dipped alone) the release
+// keeps min_duration.
+TEST(Detection, TheMeasuredForceShortensTheSensorRelease) {
+  for (const double level : {3.0, 20.0}) {
+    const ReleaseRun agreed = run_detector(level, true, 0.0);
+    EXPECT_EQ(agreed.onsets, 1) << level;
+    EXPECT_NEAR(agreed.released_at, kForceOff + 0.001 + kDt, 1e-9) << level;
+    EXPECT_EQ(agreed.declared_after_off, 0) << level;
+    const ReleaseRun disagreed = run_detector(level, true, 10.0);  // over ratio × F_min = 2.5 N
+    EXPECT_NEAR(disagreed.released_at, kForceOff + 0.005 + kDt, 1e-9) << level;
   }
 }
 

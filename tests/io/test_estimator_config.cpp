@@ -31,6 +31,7 @@ TEST(EstimatorConfig, ReadsEveryKeyOfAFullFile) {
   EXPECT_EQ(o.detection.f_min, 4.0);
   EXPECT_EQ(o.detection.release_ratio, 0.6);
   EXPECT_EQ(o.detection.min_duration, 0.004);
+  EXPECT_EQ(o.detection.sensor_release_duration, 0.002);
   EXPECT_EQ(o.acceleration, AccelerationRoute::kResidual);
   ASSERT_TRUE(o.friction.has_value());
   EXPECT_EQ(o.friction->viscous, VectorX::Constant(7, 0.1));
@@ -125,6 +126,7 @@ TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
     EXPECT_EQ(x.detection.f_min, y.detection.f_min) << file;
     EXPECT_EQ(x.detection.release_ratio, y.detection.release_ratio) << file;
     EXPECT_EQ(x.detection.min_duration, y.detection.min_duration) << file;
+    EXPECT_EQ(x.detection.sensor_release_duration, y.detection.sensor_release_duration) << file;
     EXPECT_EQ(x.acceleration, y.acceleration) << file;
     EXPECT_EQ(x.differentiation_cutoff, y.differentiation_cutoff) << file;
     EXPECT_EQ(x.friction.has_value(), y.friction.has_value()) << file;
@@ -195,6 +197,8 @@ INSTANTIATE_TEST_SUITE_P(
                   ":4:", "detection.release_ratio", "(0, 1]"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  min_duration: -0.1\n",
                   ":4:", "detection.min_duration", ">= 0"},
+        BadConfig{"sensor: {type: ft}\ndetection:\n  sensor_release_duration: soon\n",
+                  ":4:", "detection.sensor_release_duration", "finite number"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: 0\n", ":4:", "detection.f_min", "> 0"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: inf\n", ":4:", "detection.f_min",
                   "expected a finite number, got 'inf'"},

@@ -339,9 +339,10 @@ TEST(EstimatorLoop, TwoSimultaneousContactsRaiseTheDisagreementFlagAndOneDoesNot
   }
 }
 
-// Issue 9, acceptance 4: with a base sensor the contact ends with the sensor's force, ≤ 5 ms (the
-// default min_duration, which debounces both edges) after the push ends, where the residual alone
-// took 5–36 ms to decay below its release level. Exact model and ±1 % parameter errors.
+// Issue 9, acceptance 4: with a base sensor the contact ends with the sensor's force, ≤ 5 ms after
+// the push ends (min_duration, or sensor_release_duration once the force with q̈ measured agrees),
+// where the residual alone took 5–36 ms to decay below its release level. Exact model and ±1 %
+// parameter errors.
 TEST(EstimatorLoop, WithABaseSensorTheContactIsReleasedWithinFiveMillisecondsOfTheForceEnding) {
   SeededRng rng(91);
   double worst = 0.0;

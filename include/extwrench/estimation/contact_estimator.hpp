@@ -111,7 +111,13 @@ class ContactEstimator {
                 const Vector6& reading_S) noexcept;  // stages 5–9
   BaseWrench base_sensor_reading(const Vector6& reading_S, std::uint32_t& flags) noexcept;
   WrenchFit table_one_case(int link, const BaseWrench& base, std::uint32_t& flags) noexcept;
-  double sensor_release_force(const BaseWrench& base) noexcept;
+  /// The sensor's force now, for the release (NaN when unknown): the smaller of the two routes
+  /// (`either`) and the one with q̈ measured (`measured`, independent of the contact point).
+  struct ReleaseForces {
+    double either = ContactDetector::kNoReleaseForce;
+    double measured = ContactDetector::kNoReleaseForce;
+  };
+  ReleaseForces sensor_release_forces(const BaseWrench& base) noexcept;
   void differentiate_velocity(double dt, const Eigen::Ref<const VectorX>& dq) noexcept;
   void known_point_force(int link, WrenchFit& fit, std::uint32_t& flags) noexcept;
   int geometric_isolation(int residual_link, const BaseWrench& base, std::uint32_t& flags) noexcept;

@@ -7,7 +7,8 @@
 //    the base force likewise with ‖F̂_ext‖ and F_min (release level = release_ratio × on level);
 //  - the raw detection is "any joint or the base force over"; a contact is declared once the raw
 //    detection has held for min_duration seconds and released once it has been off for
-//    min_duration seconds (debouncing both edges);
+//    min_duration seconds (debouncing both edges), or for sensor_release_duration when the base
+//    sensor's instantaneous force says the contact has ended;
 //  - link = the largest joint index over threshold (Remark 1: a wrench on link l only moves
 //    τ_ext,1..l); a base-sensor detection with no joint over threshold is link 0.
 //
@@ -30,6 +31,11 @@ struct DetectionOptions {
   double f_min = 5.0;           ///< F_min on ‖F̂_ext‖ from the base sensor [N]
   double release_ratio = 0.5;   ///< off level = ratio × on level, in (0, 1]
   double min_duration = 0.005;  ///< [s] ≥ 0, for both onset and release
+  /// [s] ≥ 0: how long the base sensor's instantaneous force (the release force) must stay below
+  /// its release level to end a contact. Shorter than min_duration because that force needs no
+  /// residual to decay and no threshold to rise over noise: 1 ms = two samples at 1 kHz below
+  /// the level (docs/estimator.md#release-from-the-sensor).
+  double sensor_release_duration = 0.001;
 };
 
 struct DetectionResult {
@@ -66,10 +72,12 @@ class ContactDetector {
   /// their thresholds; a force that ended leaves a residual decaying to < 1 % by then), the
   /// force is still there and the release was wrong (the sensor's instantaneous force assumes
   /// the isolated link, which may be the wrong one): the contact is declared again and the
-  /// sensor may not release it until every threshold has dropped.
+  /// sensor may not release it until every threshold has dropped. The release holds for
+  /// min_duration, or for sensor_release_duration while measured_release_force_norm (the force
+  /// with q̈ measured, which assumes no contact point; NaN when unknown) is below the level too.
   const DetectionResult& update(double t, const Eigen::Ref<const VectorX>& tau_ext,
-                                double base_force_norm,
-                                double release_force_norm = kNoReleaseForce) noexcept;
+                                double base_force_norm, double release_force_norm = kNoReleaseForce,
+                                double measured_release_force_norm = kNoReleaseForce) noexcept;
   static constexpr double kNoReleaseForce = std::numeric_limits<double>::quiet_NaN();
   [[nodiscard]] const DetectionResult& result() const noexcept { return result_; }
   /// The joint thresholds in force: τ_min + b ∘ |q̇| at the last set_motion (τ_min when constant).
