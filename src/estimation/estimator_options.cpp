@@ -44,6 +44,9 @@ void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   if (!(o.isolation.ambiguity_distance >= 0.0) || !std::isfinite(o.isolation.ambiguity_distance)) {
     throw Error(where + ": isolation.ambiguity_distance: expected a finite value >= 0 [m]");
   }
+  if (!(o.isolation.misfit_margin >= 0.0) || !std::isfinite(o.isolation.misfit_margin)) {
+    throw Error(where + ": isolation.misfit_margin: expected a finite value >= 0");
+  }
   if (o.drift) {
     const auto positive = [&](double v, const char* name) {
       if (!(v > 0.0) || !std::isfinite(v))

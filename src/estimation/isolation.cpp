@@ -30,11 +30,10 @@ bool predicts_residual(const Matrix6X& J, const WrenchFit& fit, const VectorX& t
   return true;
 }
 
-/// One tested candidate: where its line enters its shapes (abscissa u·p), or how far it misses.
+/// One tested candidate: whether its own line enters its shapes, and how well it fits τ̂.
 struct CandidateHit {
   bool hit = false;
-  double abscissa = kInf;  ///< u·p_entry [m]: smaller is met first by a pusher coming along u
-  double misfit = kInf;    ///< of its residual prediction (predicts_residual)
+  double misfit = kInf;  ///< of its residual prediction (predicts_residual)
 };
 
 CandidateHit test_candidate(const Model& model, const Data& data, const GeometryModel& geometry,
@@ -61,7 +60,6 @@ CandidateHit test_candidate(const Model& model, const Data& data, const Geometry
       intersect_line_with_body(geometry, l, X_WL, p_W, u_W, OnMiss::kNothing);
   if (res.hit) {
     out.hit = true;
-    out.abscissa = u_W.dot(res.entry.point_W);
     t.entry = res.entry;
   }
   return out;
@@ -110,15 +108,13 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   // Candidate links are bodies l_r … last; at most 64 fit the candidate mask.
   const int last =
       std::min({model.num_bodies() - 1, static_cast<int>(geometry.body_shapes.size()) - 1, 63});
-  CandidateHit best;
-  int best_link = -1;
-  // Abscissae of the consistent hits, to judge ambiguity once the best is known.
-  double abscissa[64], misfit[64];
+  // The misfits of the consistent candidates whose own line meets their shapes (kInf otherwise).
+  double misfit[64];
+  int best_fit = -1;
   // The lowest candidate with shapes whose case is not observable (it could hold the contact but
   // cannot be tested: without a sensor, a link with fewer than six joints before it).
   int lowest_untested = last + 1;
   for (int l = in.residual_link; l <= last; ++l) {
-    abscissa[l] = kInf;
     misfit[l] = kInf;
     if (geometry.body_shapes[static_cast<std::size_t>(l)].empty()) continue;
     bool testable = false, consistent = false;
@@ -127,30 +123,44 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
     if (!testable) lowest_untested = std::min(lowest_untested, l);
     if (!consistent) continue;
     res.candidates |= std::uint64_t{1} << l;
-    if (c.hit) {
-      abscissa[l] = c.abscissa;
-      misfit[l] = c.misfit;
-      if (!best.hit || c.abscissa < best.abscissa) {
-        best = c;
-        best_link = l;
-      }
-    }
+    if (!c.hit) continue;
+    misfit[l] = c.misfit;
+    if (best_fit < 0 || c.misfit < misfit[best_fit]) best_fit = l;
   }
   // No consistent line meets a candidate's shapes: geometry has no say, the paper's rule stands.
-  if (best_link < 0) return res;
-  // Entries within ambiguity_distance of the first are equally good as geometry goes (the lines
-  // carry errors of that order): among them the candidate that explains τ̂ best.
-  const double first = best.abscissa;
+  if (best_fit < 0) return res;
+  // Candidates within misfit_margin of the best fit explain τ̂ equally well: a push on link l
+  // with no torque on joints l+1… fits link l+1 too. Each candidate's own line is a different
+  // fit, so they are compared on one line, the best fit's: the contact is where a pusher coming
+  // along it first meets one of them. Another entry within ambiguity_distance of the first makes
+  // the choice ambiguous (the line carries errors of that order). Measured against letting the
+  // better fit win within ambiguity_distance, the first entry isolated as well or better in
+  // MuJoCo closed loop and in the KDL test (paper arm, no sensor: 84.6 against 82.9 %).
+  const TestedCandidate& line = ws.tested[static_cast<std::size_t>(best_fit)];
+  const Vector3& u_W = line.line_direction_W;
+  double abscissa[64];
+  int first = best_fit;
+  abscissa[best_fit] = u_W.dot(line.entry.point_W);
   for (int l = in.residual_link; l <= last; ++l) {
-    if (l == best_link || !(abscissa[l] - first <= options.ambiguity_distance)) continue;
-    res.ambiguous = true;
-    if (misfit[l] < misfit[best_link]) best_link = l;
+    if (l == best_fit) continue;
+    abscissa[l] = kInf;
+    if (!(misfit[l] <= misfit[best_fit] + options.misfit_margin)) continue;
+    const SurfacePointResult hit =
+        intersect_line_with_body(geometry, l, data.X_WB[static_cast<std::size_t>(l)],
+                                 line.line_point_W, u_W, OnMiss::kNothing);
+    if (!hit.hit) continue;
+    abscissa[l] = u_W.dot(hit.entry.point_W);
+    if (abscissa[l] < abscissa[first]) first = l;
   }
-  res.link = best_link;
+  for (int l = in.residual_link; l <= last; ++l) {
+    if (l != first && abscissa[l] - abscissa[first] <= options.ambiguity_distance)
+      res.ambiguous = true;
+  }
+  res.link = first;
   res.decided = true;
   // A link below the chosen one could not be tested: it may hold the contact as well (a push on
   // the paper arm's link 4 without a sensor fits a force on link 6 within tolerance).
-  if (lowest_untested < best_link) res.ambiguous = true;
+  if (lowest_untested < first) res.ambiguous = true;
   return res;
 }
 

@@ -207,7 +207,8 @@ void read_payload(const YamlReader& rd, const YAML::Node& p, const Model& model,
   o.payload = pl;
 }
 
-// isolation: residual | geometry, or {rule: residual | geometry, tolerance, ambiguity_distance}.
+// isolation: residual | geometry, or {rule: residual | geometry, tolerance, ambiguity_distance,
+// misfit_margin}.
 void read_isolation(const YamlReader& rd, const YAML::Node& node, IsolationOptions& o) {
   const auto rule = [&](const YAML::Node& r, const std::string& key) {
     return rd.one_of(r, key, {"residual", "geometry"}) == 0 ? IsolationRule::kResidual
@@ -217,11 +218,12 @@ void read_isolation(const YamlReader& rd, const YAML::Node& node, IsolationOptio
     o.rule = rule(node, "isolation");
     return;
   }
-  rd.only_keys(node, "isolation", {"rule", "tolerance", "ambiguity_distance"});
+  rd.only_keys(node, "isolation", {"rule", "tolerance", "ambiguity_distance", "misfit_margin"});
   if (node["rule"]) o.rule = rule(node["rule"], "isolation.rule");
   rd.set_number_in(node, "isolation", "tolerance", {0, 1e9, true, "> 0 (x tau_min)"}, o.tolerance);
   rd.set_number_in(node, "isolation", "ambiguity_distance", {0, 1e9, false, ">= 0 [m]"},
                    o.ambiguity_distance);
+  rd.set_number_in(node, "isolation", "misfit_margin", {0, 1e9, false, ">= 0"}, o.misfit_margin);
 }
 
 // drift: true | false, or {time_constant, max_torque_rate, max_force_rate, max_moment_rate}.
@@ -444,11 +446,12 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   const IsolationOptions defaults;
   const IsolationOptions& iso = o.isolation;
   if (iso.rule || iso.tolerance != defaults.tolerance ||
-      iso.ambiguity_distance != defaults.ambiguity_distance) {
+      iso.ambiguity_distance != defaults.ambiguity_distance ||
+      iso.misfit_margin != defaults.misfit_margin) {
     y << "isolation: {";
     if (iso.rule) y << "rule: " << to_string(*iso.rule) << ", ";
     y << "tolerance: " << iso.tolerance << ", ambiguity_distance: " << iso.ambiguity_distance
-      << "}\n";
+      << ", misfit_margin: " << iso.misfit_margin << "}\n";
   }
   const UncertaintyOptions& u = o.uncertainty;
   y << "uncertainty:\n  residual_sigma: " << io_detail::yaml_list(u.residual_sigma)

@@ -41,6 +41,10 @@ TEST(EstimatorConfig, ReadsEveryKeyOfAFullFile) {
   EXPECT_EQ(c.robot.model.bodies[o.payload->body].name, "link7");
   EXPECT_EQ(o.payload->inertia.mass, 0.5);
   EXPECT_EQ(o.payload->inertia.inertia_com(2, 2), 0.0005);
+  EXPECT_EQ(o.isolation.rule, IsolationRule::kGeometry);
+  EXPECT_EQ(o.isolation.tolerance, 1.5);
+  EXPECT_EQ(o.isolation.ambiguity_distance, 0.02);
+  EXPECT_EQ(o.isolation.misfit_margin, 0.1);
   EXPECT_EQ(o.solver.max_condition, 2000.0);
   EXPECT_EQ(o.solver.rank_tolerance, 1e-6);
   EXPECT_EQ(o.uncertainty.residual_sigma.size(), 7);
@@ -128,6 +132,10 @@ TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
     EXPECT_EQ(x.detection.min_duration, y.detection.min_duration) << file;
     EXPECT_EQ(x.detection.sensor_release_duration, y.detection.sensor_release_duration) << file;
     EXPECT_EQ(x.acceleration, y.acceleration) << file;
+    EXPECT_EQ(x.isolation.rule, y.isolation.rule) << file;
+    EXPECT_EQ(x.isolation.tolerance, y.isolation.tolerance) << file;
+    EXPECT_EQ(x.isolation.ambiguity_distance, y.isolation.ambiguity_distance) << file;
+    EXPECT_EQ(x.isolation.misfit_margin, y.isolation.misfit_margin) << file;
     EXPECT_EQ(x.differentiation_cutoff, y.differentiation_cutoff) << file;
     EXPECT_EQ(x.friction.has_value(), y.friction.has_value()) << file;
     EXPECT_EQ(x.payload.has_value(), y.payload.has_value()) << file;
@@ -200,6 +208,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"sensor: {type: ft}\ndetection:\n  sensor_release_duration: soon\n",
                   ":4:", "detection.sensor_release_duration", "finite number"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: 0\n", ":4:", "detection.f_min", "> 0"},
+        BadConfig{"sensor: {type: ft}\nisolation:\n  misfit_margin: -1\n",
+                  ":4:", "isolation.misfit_margin", ">= 0"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: inf\n", ":4:", "detection.f_min",
                   "expected a finite number, got 'inf'"},
         BadConfig{"sensor: {type: ft}\ncontact:\n  model: known_point\n  link: link99\n",

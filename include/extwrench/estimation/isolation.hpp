@@ -6,10 +6,12 @@
 //    case C, the fit on J_l for D and E), must predict the whole residual τ̂_ext (every joint,
 //    zero beyond l) within tolerance × τ_min;
 //  - its line of action must meet l's collision shapes.
-// Among the consistent candidates the contact is where a pusher coming along the line first
-// meets the arm: the smallest entry abscissa u·p over the candidates' shapes. Two candidates
-// whose entries lie within ambiguity_distance of each other are equally good: kAmbiguous; so is
-// a choice above a candidate that could not be tested (its case not observable).
+// Misfit m_l = Σ_i ((τ_pred,i − τ̂_i)/(tolerance τ_min,i))². The consistent candidates whose misfit
+// lies within misfit_margin of the smallest explain τ̂ equally well; among them the contact is
+// where a pusher coming along the best fit's line first meets the arm: the smallest entry
+// abscissa u·p over their shapes. Another entry within ambiguity_distance of the first makes the
+// choice kAmbiguous; so does a choice above a candidate that could not be tested (its case not
+// observable).
 // Real time: noexcept, no allocation (the workspace is sized once).
 #pragma once
 
@@ -39,7 +41,10 @@ struct IsolationOptions {
   /// Unset: kGeometry when some body has a collision shape, else kResidual.
   std::optional<IsolationRule> rule;
   double tolerance = 1.0;            ///< a joint is predicted within tolerance × τ_min,i, > 0
-  double ambiguity_distance = 0.01;  ///< [m] ≥ 0: entries this close are equally good
+  double ambiguity_distance = 0.01;  ///< [m] ≥ 0: entries this close to the first: ambiguous
+  /// ≥ 0: candidates whose misfit exceeds the best fit's by less are equally good by the
+  /// residual, and geometry decides among them (0.05: one joint off by 0.22 × tolerance × τ_min).
+  double misfit_margin = 0.05;
 };
 
 /// The rule in force for a geometry (the default resolved).
@@ -77,7 +82,7 @@ struct IsolationWorkspace {
 struct IsolationResult {
   int link = -1;                 ///< the chosen link
   std::uint64_t candidates = 0;  ///< bit l: link l consistent (the chosen one included)
-  bool ambiguous = false;        ///< another consistent entry within ambiguity_distance, or
+  bool ambiguous = false;        ///< another equally good entry within ambiguity_distance, or
                                  ///< a candidate below the chosen link that could not be tested
   bool decided = false;          ///< false: no candidate could be tested (paper's rule kept);
                                  ///< true: ws.tested[link] holds the chosen link's fit and entry
