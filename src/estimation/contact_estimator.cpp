@@ -472,14 +472,16 @@ WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
   const Vector3& O_l = data_.X_WB[static_cast<std::size_t>(link)].translation;
   point_jacobian(model_, data_, link, O_l, J_);  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l
   // Geometric isolation made this very solve already (same J_l, τ̂ and warm start): take it over.
+  // A link chosen along another candidate's line takes that candidate's fit (isolation.hpp).
   const auto l = static_cast<std::size_t>(link);
-  const bool solved = link == geometric_link_ && link == spectrum_link_;
+  const bool borrowed = link == geometric_link_ && isolation_ws_.tested[l].borrowed;
+  const bool solved = link == geometric_link_ && (link == spectrum_link_ || borrowed);
   WrenchFit fit =
       solved ? isolation_ws_.tested[l].fit
              : wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
                            options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
-  if (solved) spectrum_ = isolation_ws_.guess[l];
-  spectrum_link_ = link;
+  if (solved && !borrowed) spectrum_ = isolation_ws_.guess[l];
+  spectrum_link_ = borrowed ? -1 : link;  // no warm start of this link's own solve
   if (options_.sensor.type != SensorType::kForceTorque) out_.condition_number = fit.condition;
   if (fit.fitted_force) {
     out_.force_W = fit.force_W;
@@ -545,10 +547,15 @@ void ContactEstimator::contact_point(int link, const WrenchFit& fit, bool contac
       flags |= EstimateFlag::kMoment;
     }
   } else if (fit.ok && contact) {
-    if (line_of_action(fit, O_l, out_.line_point_W, out_.line_direction_W)) {
+    const TestedCandidate& c = isolation_ws_.tested[static_cast<std::size_t>(link)];
+    const bool borrowed = link == geometric_link_ && c.borrowed;
+    if (borrowed) {  // the line isolation chose the link by (bit for bit)
+      out_.line_point_W = c.line_point_W;
+      out_.line_direction_W = c.line_direction_W;
+    }
+    if (borrowed || line_of_action(fit, O_l, out_.line_point_W, out_.line_direction_W)) {
       flags |= EstimateFlag::kLineOfAction;
       // Geometric isolation met this very line with this link's shapes already: take its entry.
-      const TestedCandidate& c = isolation_ws_.tested[static_cast<std::size_t>(link)];
       const bool known =
           link == geometric_link_ && c.is_line(out_.line_point_W, out_.line_direction_W);
       locate_on_surface(geometry_, link, X_WL, out_, flags, surface_normal_W_,

@@ -55,15 +55,19 @@ struct IsolationOptions {
 /// later stages take it over for the chosen link instead of computing it again.
 struct TestedCandidate {
   WrenchFit fit;  ///< its Table I fit (ok: the case is observable on the link)
-  /// Consistent candidates: the line of action p̂ + λ u, and (when the line meets the link's
-  /// shapes) its entry, the smallest-λ hit.
+  /// Consistent candidates: the line of action p̂ + λ u, and (for the best fit, when its line
+  /// meets the link's shapes) its entry, the smallest-λ hit.
   Vector3 line_point_W = Vector3::Zero();
   Vector3 line_direction_W = Vector3::Zero();
   LineHit entry;
+  bool has_entry = false;  ///< `entry` is this line's (the best fit's line met its shapes)
+  /// The chosen link is not the best fit: `fit` is the best fit's (moment about this link's
+  /// origin), the line its line, `entry` where that line first meets this link.
+  bool borrowed = false;
 
   /// True when `entry` was computed for this very line (bit for bit).
   [[nodiscard]] bool is_line(const Vector3& point_W, const Vector3& direction_W) const noexcept {
-    return point_W == line_point_W && direction_W == line_direction_W;
+    return has_entry && point_W == line_point_W && direction_W == line_direction_W;
   }
 };
 
