@@ -5,6 +5,7 @@
 // tests/system/test_new_user.cpp: 20 N on link 4 reported, unflagged, as ~9 N on link 6).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "extwrench/dynamics/data.hpp"
@@ -57,6 +58,70 @@ TEST(Isolation, WithoutASensorAChoiceAboveALinkThatCannotBeTestedIsFlaggedAmbigu
   }
   // The case of the issue: some of these configurations choose a link above.
   EXPECT_GT(decided, 0);
+}
+
+// Without a sensor a push on link 6 that leaves joint 7 at ~0 fits link 7 about as well: the
+// candidates are compared on the best fit's line, and a link chosen along it that is not the
+// best fit takes that fit over (`borrowed`). What it reports must be one physical wrench: its
+// moment shifted to the chosen link's origin gives the same line, the entry lies on that line,
+// and on the joints both links share it predicts the same torques.
+TEST(Isolation, ALinkChosenAlongTheBestFitsLineReportsThatFitsWrenchAndLine) {
+  const RobotDescription robot =
+      load_robot(std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf");
+  const Model& model = robot.model;
+  Data data(model);
+  IsolationWorkspace ws(model);
+  const VectorX tau_min = VectorX::Ones(model.nq());
+  int borrowed = 0;
+  for (int k = 0; k < 400; ++k) {
+    VectorX q(model.nq());
+    for (int i = 0; i < model.nq(); ++i) q[i] = 1.2 * std::sin(1.3 * k + 2.1 * i + 0.4);
+    forward_kinematics(model, data, q);
+    const int link = 6 + k % 2;
+    const Pose& X_WL = data.X_WB[static_cast<std::size_t>(link)];
+    const double a = 0.7 * k;
+    const Vector3 p_W = X_WL.act(Vector3(0.07 * std::cos(a), 0.07 * std::sin(a), 0.02 * (k % 5)));
+    const Vector3 F_W =
+        X_WL.rotation * Vector3(-12.0 * std::cos(a), -12.0 * std::sin(a), 6.0 * std::sin(0.3 * k));
+    Matrix6X J(6, model.nq());
+    point_jacobian(model, data, link, p_W, J);
+    const VectorX tau_ext = J.topRows<3>().transpose() * F_W;
+    const BaseWrench none{};
+    IsolationInputs in;
+    in.sensor = SensorType::kNone;
+    in.residual_link = 6;
+    in.tau_ext = &tau_ext;
+    in.tau_min = &tau_min;
+    in.base = &none;
+    const IsolationResult r =
+        isolate_on_geometry(model, data, robot.geometry, in, IsolationOptions{}, {}, ws);
+    if (!r.decided) continue;
+    const TestedCandidate& c = ws.tested[static_cast<std::size_t>(r.link)];
+    if (!c.borrowed) continue;
+    ++borrowed;
+    const int other = r.link == 6 ? 7 : 6;  // the best fit
+    const TestedCandidate& best = ws.tested[static_cast<std::size_t>(other)];
+    EXPECT_EQ(c.fit.force_W, best.fit.force_W);
+    const Vector3& O_l = data.X_WB[static_cast<std::size_t>(r.link)].translation;
+    Vector3 p, u;
+    ASSERT_TRUE(line_of_action(c.fit, O_l, p, u));
+    EXPECT_LT((u - c.line_direction_W).norm(), 1e-12);
+    const Vector3 w = c.line_point_W - p;
+    EXPECT_LT((w - w.dot(u) * u).norm(), 1e-9) << "the shifted moment moves the line";
+    const Vector3 e = c.entry.point_W - c.line_point_W;
+    EXPECT_LT((e - e.dot(u) * u).norm(), 1e-9) << "the entry is not on the line";
+    // Joints 1..6 are shared: the wrench on link 6 about O_6 and on link 7 about O_7 must
+    // predict the same torques there.
+    Matrix6X J_l(6, model.nq()), J_b(6, model.nq());
+    point_jacobian(model, data, r.link, O_l, J_l);
+    point_jacobian(model, data, other, data.X_WB[static_cast<std::size_t>(other)].translation, J_b);
+    Vector6 w_l, w_b;
+    w_l << c.fit.force_W, c.fit.moment_O;
+    w_b << best.fit.force_W, best.fit.moment_O;
+    const VectorX tau_l = J_l.transpose() * w_l, tau_b = J_b.transpose() * w_b;
+    EXPECT_LT((tau_l.head(6) - tau_b.head(6)).cwiseAbs().maxCoeff(), 1e-9);
+  }
+  EXPECT_GT(borrowed, 0) << "no configuration chose a link along another candidate's line";
 }
 
 }  // namespace
