@@ -69,7 +69,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   J_ = Matrix6X::Zero(6, n_);
   dforce_dddq_.setZero(3, n_);
   dmoment_dddq_.setZero(3, n_);
-  minv_jvt_.setZero(n_, 3);
+  minv_jvt_r_.setZero(n_, 4);
   out_.residual = VectorX::Zero(n_);
   if (options_.drift) {
     JointFriction friction = observer_.friction();

@@ -47,28 +47,25 @@ ContactEstimator::ReleaseForces ContactEstimator::sensor_release_forces(
           p_s.cross(dforce_dddq_.col(j - 1));
     }
   }
-  minv_jvt_ = J_.topRows<3>().transpose();
-  b_ = observer_.residual();
+  minv_jvt_r_.leftCols<3>() = J_.topRows<3>().transpose();
+  minv_jvt_r_.col(3) = observer_.residual();
   if (n_ <= kInlineJoints) {
-    for (int k = 0; k < 3; ++k) {
-      auto col = minv_jvt_.col(k);
-      ldlt_solve(mass_ldlt_, col);
-    }
-    ldlt_solve(mass_ldlt_, b_);
+    ldlt_solve_columns(mass_ldlt_, minv_jvt_r_);
   } else {
-    data_.mass_llt.solveInPlace(minv_jvt_);
-    data_.mass_llt.solveInPlace(b_);
+    data_.mass_llt.solveInPlace(minv_jvt_r_);
   }
-  Matrix3 A = Matrix3::Identity() + dforce_dddq_ * minv_jvt_;
-  Vector3 y = base.force_W + dforce_dddq_ * b_;
+  const auto minv_jvt = minv_jvt_r_.leftCols<3>();  // B⁻¹ J_vᵀ
+  const auto minv_r = minv_jvt_r_.col(3);           // B⁻¹ r
+  Matrix3 A = Matrix3::Identity() + dforce_dddq_ * minv_jvt;
+  Vector3 y = base.force_W + dforce_dddq_ * minv_r;
   if (moments) {
     // Rows weighted by 1/σ: the force rows by 1/σ_f, the moment rows by 1/σ_n (the noise model
     // when configured, else σ_n = σ_f × 0.1 m).
     double lever = 0.1;  // σ_n/σ_f [m]
     if (noise_.configured && noise_.force_W.trace() > 0.0 && noise_.moment_W.trace() > 0.0)
       lever = std::sqrt(noise_.moment_W.trace() / noise_.force_W.trace());
-    const Matrix3 A_n = (skew(p_W - p_s) + dmoment_dddq_ * minv_jvt_) / lever;
-    const Vector3 y_n = (base.dn_W + dmoment_dddq_ * b_) / lever;
+    const Matrix3 A_n = (skew(p_W - p_s) + dmoment_dddq_ * minv_jvt) / lever;
+    const Vector3 y_n = (base.dn_W + dmoment_dddq_ * minv_r) / lever;
     y = A.transpose() * y + A_n.transpose() * y_n;  // normal equations
     A = A.transpose() * A + A_n.transpose() * A_n;
   }

@@ -177,7 +177,8 @@ class ContactEstimator {
   Matrix6X J_;
   Eigen::Matrix<double, 3, Eigen::Dynamic> dforce_dddq_;  ///< ∂f̃_g/∂q̈ (3×n), release force
   Eigen::Matrix<double, 3, Eigen::Dynamic> dmoment_dddq_;  ///< ∂ñ_g/∂q̈ (3×n, about O_s), F/T
-  Eigen::Matrix<double, Eigen::Dynamic, 3> minv_jvt_;      ///< B⁻¹ J_vᵀ (n×3), release force
+  /// B⁻¹ [J_vᵀ r] (n×4, row-major: one row operation per step of the substitutions), release
+  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> minv_jvt_r_;
   ContactEstimate out_;
   // LDLᵀ of B(q) for q̈̂ with storage inside the object (up to kInlineJoints joints): the
   // fixed-capacity factorisation and solves are faster than the dynamic-size ones in Data.

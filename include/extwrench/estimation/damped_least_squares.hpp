@@ -67,6 +67,22 @@ template <typename Matrix>
   return true;
 }
 
+/// X ← A⁻¹ X, every column as ldlt_solve does it (the same operations, so the same bits), the
+/// columns side by side: their substitutions are independent and run as row operations (X
+/// row-major with a fixed number of columns vectorises them) instead of one dependent chain
+/// after another.
+template <typename Matrix, typename Columns>
+inline void ldlt_solve_columns(const Matrix& LD, Columns& X) noexcept {
+  const int n = static_cast<int>(LD.rows());
+  for (int i = 1; i < n; ++i) {
+    for (int k = 0; k < i; ++k) X.row(i) -= LD(i, k) * X.row(k);
+  }
+  for (int i = 0; i < n; ++i) X.row(i) *= LD(i, i);
+  for (int i = n - 2; i >= 0; --i) {
+    for (int k = i + 1; k < n; ++k) X.row(i) -= LD(k, i) * X.row(k);
+  }
+}
+
 /// x ← A⁻¹ x with the factor of ldlt_in_place.
 template <typename Matrix, typename Vector>
 inline void ldlt_solve(const Matrix& LD, Vector& x) noexcept {
