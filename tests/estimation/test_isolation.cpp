@@ -16,36 +16,47 @@
 namespace extwrench {
 namespace {
 
-TEST(Isolation, WithoutASensorAChoiceAboveALinkThatCannotBeTestedIsFlaggedAmbiguous) {
-  const RobotDescription robot =
+/// The paper arm (capsules) without a base sensor: pushes and their geometric isolation.
+struct PaperArmWithoutSensor {
+  RobotDescription robot =
       load_robot(std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf");
   const Model& model = robot.model;
-  Data data(model);
-  IsolationWorkspace ws(model);
-  const VectorX tau_min = VectorX::Ones(model.nq());
+  Data data{robot.model};
+  IsolationWorkspace ws{robot.model};
+  VectorX tau_min = VectorX::Ones(robot.model.nq());
+  VectorX tau_ext;
+
+  /// τ_ext of force F_W at p_W on `link`, at the configuration of the last forward_kinematics.
+  void push(int link, const Vector3& p_W, const Vector3& F_W) {
+    Matrix6X J(6, model.nq());
+    point_jacobian(model, data, link, p_W, J);
+    tau_ext = J.topRows<3>().transpose() * F_W;
+  }
+  IsolationResult isolate(int residual_link) {
+    const BaseWrench none{};
+    IsolationInputs in;
+    in.sensor = SensorType::kNone;
+    in.residual_link = residual_link;
+    in.tau_ext = &tau_ext;
+    in.tau_min = &tau_min;
+    in.base = &none;
+    return isolate_on_geometry(model, data, robot.geometry, in, IsolationOptions{}, {}, ws);
+  }
+};
+
+TEST(Isolation, WithoutASensorAChoiceAboveALinkThatCannotBeTestedIsFlaggedAmbiguous) {
+  PaperArmWithoutSensor arm;
+  const Model& model = arm.model;
   int decided = 0;
   // Configurations of the paper arm's workspace; a 20 N push normal to link 4's capsule.
   for (int k = 0; k < 20; ++k) {
     VectorX q(model.nq());
     for (int i = 0; i < model.nq(); ++i)
       q[i] = 0.9 * std::sin(1.7 * k + 2.3 * i) + (i == 3 ? 1.0 : 0.0);
-    forward_kinematics(model, data, q);
-    const Pose& X_W4 = data.X_WB[4];
-    const Vector3 p_W = X_W4.act(Vector3(0.07, 0.0, 0.1));
-    const Vector3 F_W = X_W4.rotation * Vector3(-20.0, 0.0, 0.0);
-    Matrix6X J(6, model.nq());
-    point_jacobian(model, data, 4, p_W, J);
-    const VectorX tau_ext = J.topRows<3>().transpose() * F_W;
-
-    const BaseWrench none{};
-    IsolationInputs in;
-    in.sensor = SensorType::kNone;
-    in.residual_link = 4;
-    in.tau_ext = &tau_ext;
-    in.tau_min = &tau_min;
-    in.base = &none;
-    const IsolationResult r =
-        isolate_on_geometry(model, data, robot.geometry, in, IsolationOptions{}, {}, ws);
+    forward_kinematics(model, arm.data, q);
+    const Pose& X_W4 = arm.data.X_WB[4];
+    arm.push(4, X_W4.act(Vector3(0.07, 0.0, 0.1)), X_W4.rotation * Vector3(-20.0, 0.0, 0.0));
+    const IsolationResult r = arm.isolate(4);
     // Links 4 and 5 have fewer than six joints before them: not testable. Whatever is chosen
     // above them is flagged; otherwise the paper's rule (link 4) stands.
     if (r.decided) {
@@ -66,35 +77,22 @@ TEST(Isolation, WithoutASensorAChoiceAboveALinkThatCannotBeTestedIsFlaggedAmbigu
 // moment shifted to the chosen link's origin gives the same line, the entry lies on that line,
 // and on the joints both links share it predicts the same torques.
 TEST(Isolation, ALinkChosenAlongTheBestFitsLineReportsThatFitsWrenchAndLine) {
-  const RobotDescription robot =
-      load_robot(std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf");
-  const Model& model = robot.model;
-  Data data(model);
-  IsolationWorkspace ws(model);
-  const VectorX tau_min = VectorX::Ones(model.nq());
+  PaperArmWithoutSensor arm;
+  const Model& model = arm.model;
+  const Data& data = arm.data;
+  const IsolationWorkspace& ws = arm.ws;
   int borrowed = 0;
   for (int k = 0; k < 400; ++k) {
     VectorX q(model.nq());
     for (int i = 0; i < model.nq(); ++i) q[i] = 1.2 * std::sin(1.3 * k + 2.1 * i + 0.4);
-    forward_kinematics(model, data, q);
+    forward_kinematics(model, arm.data, q);
     const int link = 6 + k % 2;
     const Pose& X_WL = data.X_WB[static_cast<std::size_t>(link)];
     const double a = 0.7 * k;
-    const Vector3 p_W = X_WL.act(Vector3(0.07 * std::cos(a), 0.07 * std::sin(a), 0.02 * (k % 5)));
-    const Vector3 F_W =
-        X_WL.rotation * Vector3(-12.0 * std::cos(a), -12.0 * std::sin(a), 6.0 * std::sin(0.3 * k));
-    Matrix6X J(6, model.nq());
-    point_jacobian(model, data, link, p_W, J);
-    const VectorX tau_ext = J.topRows<3>().transpose() * F_W;
-    const BaseWrench none{};
-    IsolationInputs in;
-    in.sensor = SensorType::kNone;
-    in.residual_link = 6;
-    in.tau_ext = &tau_ext;
-    in.tau_min = &tau_min;
-    in.base = &none;
-    const IsolationResult r =
-        isolate_on_geometry(model, data, robot.geometry, in, IsolationOptions{}, {}, ws);
+    arm.push(
+        link, X_WL.act(Vector3(0.07 * std::cos(a), 0.07 * std::sin(a), 0.02 * (k % 5))),
+        X_WL.rotation * Vector3(-12.0 * std::cos(a), -12.0 * std::sin(a), 6.0 * std::sin(0.3 * k)));
+    const IsolationResult r = arm.isolate(6);
     if (!r.decided) continue;
     const TestedCandidate& c = ws.tested[static_cast<std::size_t>(r.link)];
     if (!c.borrowed) continue;
