@@ -143,25 +143,22 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   const TestedCandidate& line = ws.tested[static_cast<std::size_t>(best_fit)];
   const Vector3& u_W = line.line_direction_W;
   double abscissa[64];
+  abscissa[best_fit] = u_W.dot(line.entry.point_W);
   int first = best_fit;
   LineHit first_entry = line.entry;
   for (int l = in.residual_link; l <= last; ++l) {
+    if (l == best_fit) continue;
     abscissa[l] = kInf;
-    if (l == best_fit) {
-      abscissa[l] = u_W.dot(line.entry.point_W);
-    } else if (misfit[l] <= misfit[best_fit] + options.misfit_margin) {
-      const SurfacePointResult hit =
-          intersect_line_with_body(geometry, l, data.X_WB[static_cast<std::size_t>(l)],
-                                   line.line_point_W, u_W, OnMiss::kNothing);
-      if (!hit.hit) continue;
-      abscissa[l] = u_W.dot(hit.entry.point_W);
-      if (abscissa[l] < abscissa[best_fit] && abscissa[l] < u_W.dot(first_entry.point_W)) {
-        first_entry = hit.entry;
-      }
+    if (!(misfit[l] <= misfit[best_fit] + options.misfit_margin)) continue;
+    const SurfacePointResult hit =
+        intersect_line_with_body(geometry, l, data.X_WB[static_cast<std::size_t>(l)],
+                                 line.line_point_W, u_W, OnMiss::kNothing);
+    if (!hit.hit) continue;
+    abscissa[l] = u_W.dot(hit.entry.point_W);
+    if (abscissa[l] < abscissa[first]) {
+      first = l;
+      first_entry = hit.entry;
     }
-  }
-  for (int l = in.residual_link; l <= last; ++l) {
-    if (abscissa[l] < abscissa[first]) first = l;
   }
   if (first != best_fit) {
     // The chosen link takes the best fit over (its moment about O_first) with its line and this
