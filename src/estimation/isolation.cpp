@@ -12,6 +12,8 @@ namespace extwrench {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// [m] beyond the bound up to which an entry can matter (rounding between λ and abscissa).
+constexpr double kBoundMargin = 1e-6;
 
 /// True when the single wrench (F̂, M̄) on the candidate reproduces τ̂_ext on every joint within
 /// its tolerance (zero torque expected beyond the candidate: J is zero there). `misfit`:
@@ -129,11 +131,8 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
     // No consistent line meets a candidate's shapes: geometry has no say, the paper's rule.
     if (best_fit < 0) return res;
     TestedCandidate& t = ws.tested[static_cast<std::size_t>(best_fit)];
-    const SurfacePointResult hit =
-        intersect_line_with_body(geometry, best_fit, data.X_WB[static_cast<std::size_t>(best_fit)],
-                                 t.line_point_W, t.line_direction_W, OnMiss::kNothing);
-    if (hit.hit) {
-      t.entry = hit.entry;
+    if (first_entry_on_body(geometry, best_fit, data.X_WB[static_cast<std::size_t>(best_fit)],
+                            t.line_point_W, t.line_direction_W, kInf, t.entry)) {
       t.has_entry = true;
       break;
     }
@@ -146,18 +145,23 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   abscissa[best_fit] = u_W.dot(line.entry.point_W);
   int first = best_fit;
   LineHit first_entry = line.entry;
+  // Entries beyond the first one's by more than ambiguity_distance change nothing: each query
+  // stops there (λ = u·(p − line_point); the margin keeps rounding off the comparison below).
+  const double lambda_of_abscissa = -u_W.dot(line.line_point_W);
   for (int l = in.residual_link; l <= last; ++l) {
     if (l == best_fit) continue;
     abscissa[l] = kInf;
     if (!(misfit[l] <= misfit[best_fit] + options.misfit_margin)) continue;
-    const SurfacePointResult hit =
-        intersect_line_with_body(geometry, l, data.X_WB[static_cast<std::size_t>(l)],
-                                 line.line_point_W, u_W, OnMiss::kNothing);
-    if (!hit.hit) continue;
-    abscissa[l] = u_W.dot(hit.entry.point_W);
+    const double max_lambda =
+        abscissa[first] + options.ambiguity_distance + lambda_of_abscissa + kBoundMargin;
+    LineHit entry;
+    if (!first_entry_on_body(geometry, l, data.X_WB[static_cast<std::size_t>(l)], line.line_point_W,
+                             u_W, max_lambda, entry))
+      continue;
+    abscissa[l] = u_W.dot(entry.point_W);
     if (abscissa[l] < abscissa[first]) {
       first = l;
-      first_entry = hit.entry;
+      first_entry = entry;
     }
   }
   if (first != best_fit) {

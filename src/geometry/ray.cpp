@@ -17,10 +17,10 @@ using namespace ray_detail;
 // Hits kept per shape by intersect_line_with_body; extreme hits are tracked beyond it.
 constexpr int kMaxHitsPerShape = 32;
 
-void collect_hits(const CollisionShape& shape, const Vector3& o, const Vector3& u,
-                  HitSink& sink) noexcept {
+void collect_hits(const CollisionShape& shape, const Vector3& o, const Vector3& u, HitSink& sink,
+                  double max_lambda = kInf) noexcept {
   if (shape.type == ShapeType::kMesh) {
-    if (shape.mesh != nullptr) mesh_hits(*shape.mesh, o, u, sink);
+    if (shape.mesh != nullptr) mesh_hits(*shape.mesh, o, u, sink, max_lambda);
     return;
   }
   std::array<ShapeHit, 4> h;
@@ -39,6 +39,35 @@ ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o,
     return cp;
   }
   return mesh_closest_on_miss(*shape.mesh, o, u);
+}
+
+// The line in the frame G of a shape of the body posed at X_WB: X_WG, o_G, u_G.
+void line_in_shape(const CollisionShape& shape, const Pose& X_WB, const Vector3& point_W,
+                   const Vector3& u_W, Pose& X_WG, Vector3& o_G, Vector3& u_G) noexcept {
+  X_WG = X_WB * shape.placement;
+  o_G.noalias() = X_WG.rotation.transpose() * (point_W - X_WG.translation);
+  u_G.noalias() = X_WG.rotation.transpose() * u_W;
+}
+
+// A hit of shape s in W. Mesh winding may be inward: the entry faces −u (orient −1), the exit
+// +u (orient +1) on a closed surface.
+LineHit hit_in_world(const ShapeHit& h, const Pose& X_WG, const Vector3& u_W, bool is_mesh,
+                     double orient, int s) noexcept {
+  LineHit w{h.lambda, X_WG.act(h.point_G), X_WG.rotation * h.normal_G, s};
+  if (is_mesh && orient * w.normal_W.dot(u_W) < 0.0) w.normal_W = -w.normal_W;
+  return w;
+}
+
+// What both body queries check: a usable line and a posed body. Out: u_W, the unit direction.
+bool usable_line(const Pose& X_WB, const Vector3& point_W, const Vector3& direction_W,
+                 Vector3& u_W) noexcept {
+  const double norm = direction_W.norm();
+  if (!(norm > 0.0) || !std::isfinite(norm) || !point_W.allFinite() || !X_WB.rotation.allFinite() ||
+      !X_WB.translation.allFinite()) {
+    return false;
+  }
+  u_W = direction_W / norm;  // (21) p(λ) = p̂ + λ u, u = F̂/‖F̂‖
+  return true;
 }
 
 }  // namespace
@@ -76,22 +105,11 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
   result.closest_lambda = kNaN;
   result.distance = kNaN;
 
-  const double norm = direction_W.norm();
-  if (!(norm > 0.0) || !std::isfinite(norm) || !point_on_line_W.allFinite() ||
-      !X_WB.rotation.allFinite() || !X_WB.translation.allFinite()) {
-    return result;
-  }
+  Vector3 u_W;
+  if (!usable_line(X_WB, point_on_line_W, direction_W, u_W)) return result;
   result.distance = kInf;
   if (body < 0 || body >= static_cast<int>(geometry.body_shapes.size())) return result;
-  // (21) p(λ) = p̂ + λ u, u = F̂/‖F̂‖
-  const Vector3 u_W = direction_W / norm;
   const int num_shapes = static_cast<int>(geometry.shapes.size());
-
-  const auto to_shape = [&](const CollisionShape& shape, Pose& X_WG, Vector3& o_G, Vector3& u_G) {
-    X_WG = X_WB * shape.placement;
-    o_G.noalias() = X_WG.rotation.transpose() * (point_on_line_W - X_WG.translation);
-    u_G.noalias() = X_WG.rotation.transpose() * u_W;
-  };
 
   std::array<ShapeHit, kMaxHitsPerShape> buffer;
   for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
@@ -99,22 +117,16 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
     const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
     Pose X_WG;
     Vector3 o_G, u_G;
-    to_shape(shape, X_WG, o_G, u_G);
+    line_in_shape(shape, X_WB, point_on_line_W, u_W, X_WG, o_G, u_G);
     HitSink sink(buffer);
     collect_hits(shape, o_G, u_G, sink);
     if (sink.distinct() == 0) continue;
     result.num_hits += sink.distinct();
     const bool is_mesh = shape.type == ShapeType::kMesh;
-    const auto to_world = [&](const ShapeHit& h, double orient) {
-      LineHit w{h.lambda, X_WG.act(h.point_G), X_WG.rotation * h.normal_G, s};
-      // Mesh winding may be inward: the entry faces −u, the exit +u on a closed surface.
-      if (is_mesh && orient * w.normal_W.dot(u_W) < 0.0) w.normal_W = -w.normal_W;
-      return w;
-    };
     if (!result.hit || sink.first().lambda < result.entry.lambda)
-      result.entry = to_world(sink.first(), -1.0);
+      result.entry = hit_in_world(sink.first(), X_WG, u_W, is_mesh, -1.0, s);
     if (!result.hit || sink.last().lambda > result.exit.lambda)
-      result.exit = to_world(sink.last(), 1.0);
+      result.exit = hit_in_world(sink.last(), X_WG, u_W, is_mesh, 1.0, s);
     result.hit = true;
   }
 
@@ -131,7 +143,7 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
     const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
     Pose X_WG;
     Vector3 o_G, u_G;
-    to_shape(shape, X_WG, o_G, u_G);
+    line_in_shape(shape, X_WB, point_on_line_W, u_W, X_WG, o_G, u_G);
     const ShapeClosestPoint cp = closest_on_miss(shape, o_G, u_G);
     if (cp.distance < result.distance) {
       result.distance = cp.distance;
@@ -141,6 +153,33 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
     }
   }
   return result;
+}
+
+bool first_entry_on_body(const GeometryModel& geometry, int body, const Pose& X_WB,
+                         const Vector3& point_on_line_W, const Vector3& direction_W,
+                         double max_lambda, LineHit& entry) noexcept {
+  Vector3 u_W;
+  if (!usable_line(X_WB, point_on_line_W, direction_W, u_W)) return false;
+  if (body < 0 || body >= static_cast<int>(geometry.body_shapes.size())) return false;
+  const int num_shapes = static_cast<int>(geometry.shapes.size());
+  bool hit = false;
+  // Only each shape's first hit is wanted: HitSink tracks it whatever its buffer holds.
+  std::array<ShapeHit, 1> buffer;
+  for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
+    if (s < 0 || s >= num_shapes) continue;
+    const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
+    Pose X_WG;
+    Vector3 o_G, u_G;
+    line_in_shape(shape, X_WB, point_on_line_W, u_W, X_WG, o_G, u_G);
+    HitSink sink(buffer);
+    // Beyond the entry found so far this shape cannot come first.
+    collect_hits(shape, o_G, u_G, sink, hit ? std::min(max_lambda, entry.lambda) : max_lambda);
+    if (sink.distinct() == 0) continue;
+    if (!hit || sink.first().lambda < entry.lambda)
+      entry = hit_in_world(sink.first(), X_WG, u_W, shape.type == ShapeType::kMesh, -1.0, s);
+    hit = true;
+  }
+  return hit;
 }
 
 }  // namespace extwrench

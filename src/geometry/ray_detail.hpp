@@ -65,9 +65,10 @@ int primitive_hits(const CollisionShape& shape, const Vector3& o, const Vector3&
 ShapeClosestPoint primitive_closest_on_miss(const CollisionShape& shape, const Vector3& o,
                                             const Vector3& u) noexcept;
 
-/// Every hit of the line with a triangle mesh into `sink`.
-void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u,
-               HitSink& sink) noexcept;
+/// Every hit of the line with a triangle mesh into `sink`; with a ray caster, those at
+/// λ ≤ max_lambda at least (farther ones may be pruned).
+void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u, HitSink& sink,
+               double max_lambda = kInf) noexcept;
 /// Surface point of a mesh nearest to a line that misses it.
 ShapeClosestPoint mesh_closest_on_miss(const TriangleMesh& m, const Vector3& o,
                                        const Vector3& u) noexcept;

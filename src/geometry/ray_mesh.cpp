@@ -78,8 +78,8 @@ void orthonormal_basis(const Vector3& u, Vector3& e1, Vector3& e2) noexcept {
 
 }  // namespace
 
-void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u,
-               HitSink& sink) noexcept {
+void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u, HitSink& sink,
+               double max_lambda) noexcept {
   if (mesh.ray_caster == nullptr) {
     ShapeHit hit;
     for (Eigen::Index t = 0; t < mesh.triangles.cols(); ++t) {
@@ -88,7 +88,11 @@ void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u,
     return;
   }
   MeshVisit v{&mesh, o, u, &sink, {}, 0, {}, 0};
-  mesh.ray_caster->for_each_line_candidate(o, u, &visit_candidate, &v);
+  if (max_lambda < kInf) {
+    mesh.ray_caster->for_each_line_candidate_up_to(o, u, max_lambda, &visit_candidate, &v);
+  } else {
+    mesh.ray_caster->for_each_line_candidate(o, u, &visit_candidate, &v);
+  }
   // A loose hit is the float caster's pick of the wrong triangle at an edge: keep it only if the
   // right one was not reported.
   for (int i = 0; i < v.num_loose; ++i) {

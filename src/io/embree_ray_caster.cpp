@@ -113,6 +113,21 @@ class EmbreeRayCaster final : public MeshRayCaster {
 
   void for_each_line_candidate(const Vector3& origin, const Vector3& direction, Visitor visit,
                                void* user) const noexcept override {
+    cast(origin, direction, std::numeric_limits<double>::infinity(), visit, user);
+  }
+
+  void for_each_line_candidate_up_to(const Vector3& origin, const Vector3& direction,
+                                     double max_lambda, Visitor visit,
+                                     void* user) const noexcept override {
+    cast(origin, direction, max_lambda, visit, user);
+  }
+
+ private:
+  // One ray over the line's part inside the box and below max_lambda (+ the box margin, so
+  // that float error loses no crossing there). The ray starts where the whole line enters the
+  // box whatever max_lambda: the same float origin, so the same candidates up to the bound.
+  void cast(const Vector3& origin, const Vector3& direction, double max_lambda, Visitor visit,
+            void* user) const noexcept {
     // Both directions of the infinite line: clip it to the (enlarged) bounding box in double,
     // then cast one ray from the box's entry to its exit.
     double t0 = -std::numeric_limits<double>::infinity();
@@ -130,6 +145,10 @@ class EmbreeRayCaster final : public MeshRayCaster {
       t1 = std::min(t1, b);
     }
     if (!(t0 <= t1) || !std::isfinite(t0) || !std::isfinite(t1)) return;
+    if (max_lambda + margin_ < t1) {
+      if (!(t0 <= max_lambda + margin_)) return;  // the box begins beyond the bound (or NaN)
+      t1 = max_lambda + margin_;
+    }
     const Vector3 start = origin + t0 * direction - centre_;
 
     QueryContext query;
@@ -155,7 +174,6 @@ class EmbreeRayCaster final : public MeshRayCaster {
     rtcIntersect1(scene_.get(), &query.context, &rh);
   }
 
- private:
   static Error error(const std::string& name, const char* what) {
     return Error(name + ": embree: " + what + " failed");
   }

@@ -401,6 +401,96 @@ TEST(RayMeshPanda, QueriesFromSeveralThreadsAgreeWithSequentialOnes) {
   EXPECT_EQ(b, sequential);
 }
 
+// The ray caster's bounded search (for_each_line_candidate_up_to) visits every triangle that
+// the line crosses at λ ≤ the bound (a brute-force solve says which), and nothing at all when
+// the mesh lies beyond it.
+TEST(RayMeshPanda, TheBoundedCandidateSearchVisitsEveryCrossingUpToTheBound) {
+  const auto files = panda_meshes();
+  if (files.empty())
+    GTEST_SKIP() << "Panda collision meshes not found under " << EXTWRENCH_SHARED_DIR;
+  SeededRng rng(27);
+  const CollisionShape shape = mesh_shape(load_mesh(files.back()));
+  const TriangleMesh& m = *shape.mesh;
+  const Vector3 lower = m.vertices.rowwise().minCoeff(), upper = m.vertices.rowwise().maxCoeff();
+  std::vector<int> visited;
+  const auto record = [](void* user, int triangle) noexcept {
+    static_cast<std::vector<int>*>(user)->push_back(triangle);
+  };
+  int crossings_checked = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vector3 u = random_unit(rng);
+    const Vector3 through = lower + (upper - lower).cwiseProduct(rng.uniform_vector3(0.2, 0.8));
+    const Vector3 o = through - rng.uniform(0.0, 0.5) * u;
+    const double bound = rng.uniform(-0.1, 0.6);
+    visited.clear();
+    m.ray_caster->for_each_line_candidate_up_to(o, u, bound, record, &visited);
+    for (Eigen::Index t = 0; t < m.triangles.cols(); ++t) {
+      double lambda = 0.0;
+      if (!solve_line_triangle(m, t, o, u, lambda) || lambda > bound) continue;
+      ++crossings_checked;
+      EXPECT_NE(std::find(visited.begin(), visited.end(), static_cast<int>(t)), visited.end())
+          << "triangle " << t << " crossed at λ = " << lambda << " ≤ " << bound;
+    }
+  }
+  EXPECT_GT(crossings_checked, 100);
+  // A bound before the line reaches the mesh's box: no candidate.
+  const Vector3 u = Vector3::UnitX();
+  const Vector3 o(lower.x() - 1.0, 0.5 * (lower.y() + upper.y()), 0.5 * (lower.z() + upper.z()));
+  visited.clear();
+  m.ray_caster->for_each_line_candidate_up_to(o, u, 0.5, record, &visited);
+  EXPECT_TRUE(visited.empty());
+  m.ray_caster->for_each_line_candidate_up_to(o, u, 1.0 + (upper.x() - lower.x()), record,
+                                              &visited);
+  EXPECT_FALSE(visited.empty());
+}
+
+// first_entry_on_body gives intersect_line_with_body's entry, bit for bit, whenever that lies
+// within the bound; no entry where the line misses; never a point before the entry. A body of
+// two Panda meshes, so the second shape is searched only up to the first one's entry.
+TEST(RayMeshPanda, TheFirstEntryUpToABoundIsTheBodyQuerysEntry) {
+  const auto files = panda_meshes();
+  if (files.size() < 2)
+    GTEST_SKIP() << "Panda collision meshes not found under " << EXTWRENCH_SHARED_DIR;
+  SeededRng rng(28);
+  GeometryModel geometry;
+  geometry.shapes = {mesh_shape(load_mesh(files[files.size() - 2])),
+                     mesh_shape(load_mesh(files.back()))};
+  geometry.shapes[1].placement = Pose::from_xyz_rpy(Vector3(0.05, -0.03, 0.08), Vector3(0.3, 0, 1));
+  geometry.body_shapes = {{0, 1}};
+  int within = 0, beyond = 0, missed = 0;
+  for (int trial = 0; trial < 600; ++trial) {
+    const Pose X_WB =
+        Pose::from_xyz_rpy(rng.uniform_vector3(-1.0, 1.0), rng.uniform_vector3(-3.0, 3.0));
+    const Vector3 u = X_WB.rotation * random_unit(rng);
+    const Vector3 p = X_WB.act(rng.uniform_vector3(-0.1, 0.15)) - rng.uniform(0.0, 0.4) * u;
+    const SurfacePointResult full = intersect_line_with_body(geometry, 0, X_WB, p, 2.0 * u);
+    const double bound = full.hit ? full.entry.lambda + rng.uniform(-0.05, 0.05) : 0.3;
+    LineHit entry;
+    const bool found = first_entry_on_body(geometry, 0, X_WB, p, 2.0 * u, bound, entry);
+    if (!full.hit) {
+      EXPECT_FALSE(found);
+      ++missed;
+      continue;
+    }
+    if (full.entry.lambda <= bound) {
+      ++within;
+      ASSERT_TRUE(found);
+      EXPECT_EQ(entry.lambda, full.entry.lambda);
+      EXPECT_EQ(entry.point_W, full.entry.point_W);
+      EXPECT_EQ(entry.normal_W, full.entry.normal_W);
+      EXPECT_EQ(entry.shape, full.entry.shape);
+    } else {
+      ++beyond;
+      if (found) {
+        EXPECT_GE(entry.lambda, full.entry.lambda);
+      }
+    }
+  }
+  EXPECT_GT(within, 100);
+  EXPECT_GT(beyond, 100);
+  EXPECT_GT(missed, 50);
+}
+
 TEST(RayMesh, EmbreeQueriesDoNotAllocate) {
   if (!test::allocation_counting_available()) GTEST_SKIP() << "allocation counting unavailable";
   const test::SimpleMesh sphere = test::icosphere_mesh(0.25, 2);

@@ -28,6 +28,16 @@ class MeshRayCaster {
   /// Real-time safe: const, noexcept, allocation-free, callable from several threads at once.
   virtual void for_each_line_candidate(const Vector3& origin, const Vector3& direction,
                                        Visitor visit, void* user) const noexcept = 0;
+
+  /// The same for the part λ ≤ max_lambda of the line (a caller after the first crossing up to
+  /// a bound): every triangle crossed there is visited; those beyond may be visited or not. The
+  /// default visits the whole line; an implementation prunes the rest.
+  virtual void for_each_line_candidate_up_to(const Vector3& origin, const Vector3& direction,
+                                             double max_lambda, Visitor visit,
+                                             void* user) const noexcept {
+    static_cast<void>(max_lambda);
+    for_each_line_candidate(origin, direction, visit, user);
+  }
 };
 
 }  // namespace extwrench
