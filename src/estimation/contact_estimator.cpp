@@ -67,8 +67,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   tau_pred_ = VectorX::Zero(n_);
   tau_eff_ = VectorX::Zero(n_);
   J_ = Matrix6X::Zero(6, n_);
-  dforce_dddq_.setZero(3, n_);
-  dmoment_dddq_.setZero(3, n_);
+  root_wrench_dddq_ = Matrix6X::Zero(6, n_);
   minv_jvt_r_.setZero(n_, 4);
   out_.residual = VectorX::Zero(n_);
   if (options_.drift) {
@@ -191,6 +190,7 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
     return s;
   }
   const double dt = t - t_;
+  ddq_supplied_ = false;
   momentum_and_bias_terms_stage(q, dq);           // 1
   observer_.integrate(data_, t, q, dq, tau);      // 2 (validated above)
   out_.status = acceleration_route(dt, dq, tau);  // 3
@@ -276,21 +276,27 @@ void ContactEstimator::ground_wrench(const Eigen::Ref<const VectorX>& dq) noexce
     tau_ext_ = data_.tau - tau_eff_;  // (a) τ̂_ext = RNEA(q, q̇, q̈̂) − (τ − τ_f)
     return;
   }
+  root_wrench_dddq_valid_ = false;
   if (need_ddq_ && out_.status.ok()) {
     // f_0 is affine in q̈: f_0(q̈̂) = f_0(0) + Σ_j Ic_j S_j q̈̂_j, Ic_j the composite inertia of
-    // the subtree of j that the CRBA of stage 3 left in data_ (about the world origin). Saves a
-    // second RNEA pass.
+    // the subtree of j that the CRBA of stage 3 left in data_ (about the world origin): with
+    // mass m, first moment h and inertia I_O, Ic_j S_j = (m s_v − h × s_ω, h × s_v + I_O s_ω).
+    // Saves a second RNEA pass; the columns are kept for the release force (stage 5b).
     Vector6 f0 = data_.root_wrench_W;
     for (int j = 1; j < model_.num_bodies(); ++j) {
       const auto js = static_cast<std::size_t>(j);
       const Vector6& s = data_.S[js];
       const double m = data_.composite_mass[js];
       const Vector3& h = data_.composite_first_moment[js];
+      auto column = root_wrench_dddq_.col(j - 1);
+      column.head<3>() = m * s.head<3>() - h.cross(s.tail<3>());
+      column.tail<3>() = h.cross(s.head<3>()) + data_.composite_inertia_O[js] * s.tail<3>();
       const double a = ddq_[j - 1];
-      f0.head<3>() += a * (m * s.head<3>() - h.cross(s.tail<3>()));
-      f0.tail<3>() += a * (h.cross(s.head<3>()) + data_.composite_inertia_O[js] * s.tail<3>());
+      f0.head<3>() += a * column.head<3>();
+      f0.tail<3>() += a * column.tail<3>();
     }
     data_.root_wrench_W = f0;
+    root_wrench_dddq_valid_ = true;
   }
   tau_ext_ = observer_.residual();  // (b) τ̂_ext = r
 }
@@ -319,6 +325,8 @@ Status ContactEstimator::update_with(double t, const Eigen::Ref<const VectorX>& 
   }
   forward_kinematics(model_, data_, q);
   ddq_ = ddq;
+  ddq_supplied_ = true;
+  root_wrench_dddq_valid_ = false;
   tau_ext_ = tau_ext;
   rnea_no_kinematics(model_, data_, dq, ddq_);
   initialized_ = true;

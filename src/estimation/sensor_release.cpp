@@ -27,45 +27,55 @@ ContactEstimator::ReleaseForces ContactEstimator::sensor_release_forces(
     const BaseWrench& base) noexcept {
   constexpr double kMinConditionInverse = 1e-3;
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  if (differentiation_) return {base.force_W.norm(), base.force_W.norm()};
-  if (!out_.status.ok() || !base.force_W.allFinite()) return {};
+  // With q̈̂ differentiated (route (a)) or given by the caller, F̂ has no residual lag.
+  if (differentiation_ || ddq_supplied_) return {base.force_W.norm(), base.force_W.norm()};
+  if (!out_.status.ok() || !root_wrench_dddq_valid_ || !base.force_W.allFinite()) return {};
   const Pose& X_WL = data_.X_WB[static_cast<std::size_t>(release_link_)];
   const Vector3 p_W = X_WL.act(release_point_L_);
-  point_jacobian(model_, data_, release_link_, p_W, J_);
   const bool moments = base.dn_W.allFinite();
   const Vector3& p_s = options_.sensor.X_WS.translation;
-  // G, H: (f̃_g, ñ_g) = −(f_0, n_0 − p_s × f_0), f_0 affine in q̈ (stage 4): column j of
-  // ∂f_0/∂q̈ is (m s_v − h × s_ω, h × s_v + I_O s_ω) of the subtree of joint j.
-  for (int j = 1; j < model_.num_bodies(); ++j) {
-    const auto js = static_cast<std::size_t>(j);
-    const Vector6& sj = data_.S[js];
-    const Vector3& h = data_.composite_first_moment[js];
-    dforce_dddq_.col(j - 1) = h.cross(sj.tail<3>()) - data_.composite_mass[js] * sj.head<3>();
-    if (moments) {
-      dmoment_dddq_.col(j - 1) =
-          -(h.cross(sj.head<3>()) + data_.composite_inertia_O[js] * sj.tail<3>()) -
-          p_s.cross(dforce_dddq_.col(j - 1));
-    }
+  // B⁻¹ [J_vᵀ r]: row j−1 of J_vᵀ is s_v + s_ω × p for the joints j that move p, else 0.
+  minv_jvt_r_.leftCols<3>().setZero();
+  for (int j = release_link_; j > 0; j = model_.parents[static_cast<std::size_t>(j)]) {
+    const Vector6& s = data_.S[static_cast<std::size_t>(j)];
+    minv_jvt_r_.row(j - 1).head<3>() = (s.head<3>() + s.tail<3>().cross(p_W)).transpose();
   }
-  minv_jvt_r_.leftCols<3>() = J_.topRows<3>().transpose();
   minv_jvt_r_.col(3) = observer_.residual();
   if (n_ <= kInlineJoints) {
     ldlt_solve_columns(mass_ldlt_, minv_jvt_r_);
   } else {
     data_.mass_llt.solveInPlace(minv_jvt_r_);
   }
-  const auto minv_jvt = minv_jvt_r_.leftCols<3>();  // B⁻¹ J_vᵀ
-  const auto minv_r = minv_jvt_r_.col(3);           // B⁻¹ r
-  Matrix3 A = Matrix3::Identity() + dforce_dddq_ * minv_jvt;
-  Vector3 y = base.force_W + dforce_dddq_ * minv_r;
+  // One pass over the joints: A = I + G B⁻¹ J_vᵀ, y = F̂ + G B⁻¹ r and (F/T) their moment rows,
+  // with G = ∂f̃_g/∂q̈ = −∂f_0/∂q̈ and H = ∂ñ_g/∂q̈ = −(∂n_0/∂q̈ − p_s × ∂f_0/∂q̈) (stage 4's
+  // columns: (f̃_g, ñ_g) = −(f_0, n_0 − p_s × f_0)); G (q̈̃ − q̈̂) for the measured force.
+  const bool measured_ok = ddq_.allFinite() && ddq_filtered_.allFinite();
+  Matrix3 A = Matrix3::Identity();
+  Vector3 y = base.force_W;
+  Matrix3 A_n = skew(p_W - p_s);
+  Vector3 y_n = base.dn_W;
+  Vector3 g_dddq = Vector3::Zero();  // G (q̈̃ − q̈̂)
+  for (int j = 0; j < n_; ++j) {
+    const auto d = root_wrench_dddq_.col(j);
+    const Vector3 g = -d.head<3>();
+    const auto row = minv_jvt_r_.row(j);
+    A.noalias() += g * row.head<3>();
+    y += row[3] * g;
+    if (moments) {
+      const Vector3 h = p_s.cross(d.head<3>()) - d.tail<3>();
+      A_n.noalias() += h * row.head<3>();
+      y_n += row[3] * h;
+    }
+    if (measured_ok) g_dddq += (ddq_filtered_[j] - ddq_[j]) * g;
+  }
   if (moments) {
     // Rows weighted by 1/σ: the force rows by 1/σ_f, the moment rows by 1/σ_n (the noise model
     // when configured, else σ_n = σ_f × 0.1 m).
     double lever = 0.1;  // σ_n/σ_f [m]
     if (noise_.configured && noise_.force_W.trace() > 0.0 && noise_.moment_W.trace() > 0.0)
       lever = std::sqrt(noise_.moment_W.trace() / noise_.force_W.trace());
-    const Matrix3 A_n = (skew(p_W - p_s) + dmoment_dddq_ * minv_jvt) / lever;
-    const Vector3 y_n = (base.dn_W + dmoment_dddq_ * minv_r) / lever;
+    A_n /= lever;
+    y_n /= lever;
     y = A.transpose() * y + A_n.transpose() * y_n;  // normal equations
     A = A.transpose() * A + A_n.transpose() * A_n;
   }
@@ -85,11 +95,7 @@ ContactEstimator::ReleaseForces ContactEstimator::sensor_release_forces(
   // level for min_duration releases: while the push lasts both see it. The measured one below it
   // releases after sensor_release_duration: the predicted one alone can dip with a model error
   // amplified by an ill-conditioned system or a wrong point (a collision's first milliseconds).
-  double measured = kInf;
-  if (ddq_.allFinite() && ddq_filtered_.allFinite()) {
-    b_ = ddq_filtered_ - ddq_;
-    measured = (base.force_W - dforce_dddq_ * b_).norm();
-  }
+  const double measured = measured_ok ? (base.force_W - g_dddq).norm() : kInf;
   const double either = std::min(predicted, measured);
   ReleaseForces out;
   if (std::isfinite(either)) out.either = either;

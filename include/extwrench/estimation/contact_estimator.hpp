@@ -175,8 +175,11 @@ class ContactEstimator {
   // Scratch, sized once.
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;
   Matrix6X J_;
-  Eigen::Matrix<double, 3, Eigen::Dynamic> dforce_dddq_;  ///< ∂f̃_g/∂q̈ (3×n), release force
-  Eigen::Matrix<double, 3, Eigen::Dynamic> dmoment_dddq_;  ///< ∂ñ_g/∂q̈ (3×n, about O_s), F/T
+  /// ∂f_0/∂q̈ (6×n): column j−1 = Ic_j S_j, the root wrench per unit q̈_j (stage 4, route (b));
+  /// the release force's G, H. Valid for this sample when root_wrench_dddq_valid_.
+  Matrix6X root_wrench_dddq_;
+  bool root_wrench_dddq_valid_ = false;
+  bool ddq_supplied_ = false;  ///< this sample's q̈̂ came from the caller (update_with)
   /// B⁻¹ [J_vᵀ r] (n×4, row-major: one row operation per step of the substitutions), release
   Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> minv_jvt_r_;
   ContactEstimate out_;
