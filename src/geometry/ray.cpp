@@ -17,10 +17,17 @@ using namespace ray_detail;
 // Hits kept per shape by intersect_line_with_body; extreme hits are tracked beyond it.
 constexpr int kMaxHitsPerShape = 32;
 
+// Every hit; with `first_only`, those that give the first hit at λ ≤ max_lambda (meshes: a
+// first-crossing search).
 void collect_hits(const CollisionShape& shape, const Vector3& o, const Vector3& u, HitSink& sink,
-                  double max_lambda = kInf) noexcept {
+                  bool first_only = false, double max_lambda = kInf) noexcept {
   if (shape.type == ShapeType::kMesh) {
-    if (shape.mesh != nullptr) mesh_hits(*shape.mesh, o, u, sink, max_lambda);
+    if (shape.mesh == nullptr) return;
+    if (first_only) {
+      mesh_first_hits(*shape.mesh, o, u, sink, max_lambda);
+    } else {
+      mesh_hits(*shape.mesh, o, u, sink);
+    }
     return;
   }
   std::array<ShapeHit, 4> h;
@@ -173,7 +180,8 @@ bool first_entry_on_body(const GeometryModel& geometry, int body, const Pose& X_
     line_in_shape(shape, X_WB, point_on_line_W, u_W, X_WG, o_G, u_G);
     HitSink sink(buffer);
     // Beyond the entry found so far this shape cannot come first.
-    collect_hits(shape, o_G, u_G, sink, hit ? std::min(max_lambda, entry.lambda) : max_lambda);
+    collect_hits(shape, o_G, u_G, sink, true,
+                 hit ? std::min(max_lambda, entry.lambda) : max_lambda);
     if (sink.distinct() == 0) continue;
     if (!hit || sink.first().lambda < entry.lambda)
       entry = hit_in_world(sink.first(), X_WG, u_W, shape.type == ShapeType::kMesh, -1.0, s);

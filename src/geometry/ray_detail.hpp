@@ -65,10 +65,14 @@ int primitive_hits(const CollisionShape& shape, const Vector3& o, const Vector3&
 ShapeClosestPoint primitive_closest_on_miss(const CollisionShape& shape, const Vector3& o,
                                             const Vector3& u) noexcept;
 
-/// Every hit of the line with a triangle mesh into `sink`; with a ray caster, those at
-/// λ ≤ max_lambda at least (farther ones may be pruned).
-void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u, HitSink& sink,
-               double max_lambda = kInf) noexcept;
+/// Every hit of the line with a triangle mesh into `sink`.
+void mesh_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u,
+               HitSink& sink) noexcept;
+/// The hits a first-crossing search needs into `sink`: its first() is the line's first hit at
+/// λ ≤ max_lambda (if any; with a ray caster, up to float rounding between crossings closer
+/// than that); other hits may be missing.
+void mesh_first_hits(const TriangleMesh& mesh, const Vector3& o, const Vector3& u, HitSink& sink,
+                     double max_lambda) noexcept;
 /// Surface point of a mesh nearest to a line that misses it.
 ShapeClosestPoint mesh_closest_on_miss(const TriangleMesh& m, const Vector3& o,
                                        const Vector3& u) noexcept;

@@ -53,17 +53,24 @@ struct GeometryDeleter {
 struct QueryContext {
   RTCIntersectContext context;  // first member: the filter casts back from it
   MeshRayCaster::Visitor visit;
+  MeshRayCaster::CrossingVisitor crossing;  // set instead of visit: first-crossing queries
   void* user;
 };
 
-/// Reports every hit Embree finds and rejects it, so traversal goes on to the next one: one
-/// rtcIntersect1 call then visits all crossed triangles.
+/// Reports every hit Embree finds. A plain query rejects each, so traversal goes on to the next
+/// one: one rtcIntersect1 call then visits all crossed triangles. A first-crossing query accepts
+/// the hits its visitor confirms: Embree then looks only for nearer ones (closest-hit traversal).
 void report_and_reject(const RTCFilterFunctionNArguments* args) {
   const auto* query = reinterpret_cast<const QueryContext*>(args->context);
   for (unsigned int i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    query->visit(query->user, static_cast<int>(RTCHitN_primID(args->hit, args->N, i)));
-    args->valid[i] = 0;
+    const auto triangle = static_cast<int>(RTCHitN_primID(args->hit, args->N, i));
+    if (query->crossing != nullptr) {
+      if (!query->crossing(query->user, triangle)) args->valid[i] = 0;
+    } else {
+      query->visit(query->user, triangle);
+      args->valid[i] = 0;
+    }
   }
 }
 
@@ -113,13 +120,13 @@ class EmbreeRayCaster final : public MeshRayCaster {
 
   void for_each_line_candidate(const Vector3& origin, const Vector3& direction, Visitor visit,
                                void* user) const noexcept override {
-    cast(origin, direction, std::numeric_limits<double>::infinity(), visit, user);
+    cast(origin, direction, std::numeric_limits<double>::infinity(), visit, nullptr, user);
   }
 
-  void for_each_line_candidate_up_to(const Vector3& origin, const Vector3& direction,
-                                     double max_lambda, Visitor visit,
-                                     void* user) const noexcept override {
-    cast(origin, direction, max_lambda, visit, user);
+  void for_each_first_crossing_candidate(const Vector3& origin, const Vector3& direction,
+                                         double max_lambda, CrossingVisitor visit,
+                                         void* user) const noexcept override {
+    cast(origin, direction, max_lambda, nullptr, visit, user);
   }
 
  private:
@@ -127,7 +134,7 @@ class EmbreeRayCaster final : public MeshRayCaster {
   // that float error loses no crossing there). The ray starts where the whole line enters the
   // box whatever max_lambda: the same float origin, so the same candidates up to the bound.
   void cast(const Vector3& origin, const Vector3& direction, double max_lambda, Visitor visit,
-            void* user) const noexcept {
+            CrossingVisitor crossing, void* user) const noexcept {
     // Both directions of the infinite line: clip it to the (enlarged) bounding box in double,
     // then cast one ray from the box's entry to its exit.
     double t0 = -std::numeric_limits<double>::infinity();
@@ -154,6 +161,7 @@ class EmbreeRayCaster final : public MeshRayCaster {
     QueryContext query;
     rtcInitIntersectContext(&query.context);
     query.visit = visit;
+    query.crossing = crossing;
     query.user = user;
     RTCRayHit rh;
     rh.ray.org_x = static_cast<float>(start.x());

@@ -401,10 +401,10 @@ TEST(RayMeshPanda, QueriesFromSeveralThreadsAgreeWithSequentialOnes) {
   EXPECT_EQ(b, sequential);
 }
 
-// The ray caster's bounded search (for_each_line_candidate_up_to) visits every triangle that
-// the line crosses at λ ≤ the bound (a brute-force solve says which), and nothing at all when
-// the mesh lies beyond it.
-TEST(RayMeshPanda, TheBoundedCandidateSearchVisitsEveryCrossingUpToTheBound) {
+// The ray caster's first-crossing search (for_each_first_crossing_candidate) visits the line's
+// first crossing whenever it lies at λ ≤ the bound (a brute-force solve of every triangle says
+// where), however much it prunes, and nothing at all when the mesh lies beyond the bound.
+TEST(RayMeshPanda, TheFirstCrossingSearchVisitsTheFirstCrossingUpToTheBound) {
   const auto files = panda_meshes();
   if (files.empty())
     GTEST_SKIP() << "Panda collision meshes not found under " << EXTWRENCH_SHARED_DIR;
@@ -412,36 +412,49 @@ TEST(RayMeshPanda, TheBoundedCandidateSearchVisitsEveryCrossingUpToTheBound) {
   const CollisionShape shape = mesh_shape(load_mesh(files.back()));
   const TriangleMesh& m = *shape.mesh;
   const Vector3 lower = m.vertices.rowwise().minCoeff(), upper = m.vertices.rowwise().maxCoeff();
-  std::vector<int> visited;
-  const auto record = [](void* user, int triangle) noexcept {
-    static_cast<std::vector<int>*>(user)->push_back(triangle);
+  struct Search {
+    const TriangleMesh* mesh;
+    Vector3 o, u;
+    int visits = 0;
+    double first = std::numeric_limits<double>::infinity();  // of the confirmed crossings
   };
-  int crossings_checked = 0;
-  for (int trial = 0; trial < 200; ++trial) {
+  const auto visit = [](void* user, int triangle) noexcept {
+    auto& s = *static_cast<Search*>(user);
+    ++s.visits;
+    double lambda = 0.0;
+    if (!solve_line_triangle(*s.mesh, triangle, s.o, s.u, lambda)) return false;
+    s.first = std::min(s.first, lambda);
+    return true;
+  };
+  int within = 0;
+  for (int trial = 0; trial < 300; ++trial) {
     const Vector3 u = random_unit(rng);
     const Vector3 through = lower + (upper - lower).cwiseProduct(rng.uniform_vector3(0.2, 0.8));
     const Vector3 o = through - rng.uniform(0.0, 0.5) * u;
-    const double bound = rng.uniform(-0.1, 0.6);
-    visited.clear();
-    m.ray_caster->for_each_line_candidate_up_to(o, u, bound, record, &visited);
+    double first = std::numeric_limits<double>::infinity();
     for (Eigen::Index t = 0; t < m.triangles.cols(); ++t) {
       double lambda = 0.0;
-      if (!solve_line_triangle(m, t, o, u, lambda) || lambda > bound) continue;
-      ++crossings_checked;
-      EXPECT_NE(std::find(visited.begin(), visited.end(), static_cast<int>(t)), visited.end())
-          << "triangle " << t << " crossed at λ = " << lambda << " ≤ " << bound;
+      if (solve_line_triangle(m, t, o, u, lambda)) first = std::min(first, lambda);
+    }
+    const double bound = rng.uniform(-0.1, 0.6);
+    Search search{&m, o, u};
+    m.ray_caster->for_each_first_crossing_candidate(o, u, bound, visit, &search);
+    if (first <= bound) {
+      ++within;
+      EXPECT_NEAR(search.first, first, 1e-9) << "trial " << trial;
     }
   }
-  EXPECT_GT(crossings_checked, 100);
-  // A bound before the line reaches the mesh's box: no candidate.
+  EXPECT_GT(within, 100);
+  // A bound before the line reaches the mesh's box: no candidate; beyond it: some.
   const Vector3 u = Vector3::UnitX();
   const Vector3 o(lower.x() - 1.0, 0.5 * (lower.y() + upper.y()), 0.5 * (lower.z() + upper.z()));
-  visited.clear();
-  m.ray_caster->for_each_line_candidate_up_to(o, u, 0.5, record, &visited);
-  EXPECT_TRUE(visited.empty());
-  m.ray_caster->for_each_line_candidate_up_to(o, u, 1.0 + (upper.x() - lower.x()), record,
-                                              &visited);
-  EXPECT_FALSE(visited.empty());
+  Search before{&m, o, u};
+  m.ray_caster->for_each_first_crossing_candidate(o, u, 0.5, visit, &before);
+  EXPECT_EQ(before.visits, 0);
+  Search after{&m, o, u};
+  m.ray_caster->for_each_first_crossing_candidate(o, u, 1.0 + (upper.x() - lower.x()), visit,
+                                                  &after);
+  EXPECT_GT(after.visits, 0);
 }
 
 // first_entry_on_body gives intersect_line_with_body's entry, bit for bit, whenever that lies

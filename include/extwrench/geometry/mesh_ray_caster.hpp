@@ -29,14 +29,29 @@ class MeshRayCaster {
   virtual void for_each_line_candidate(const Vector3& origin, const Vector3& direction,
                                        Visitor visit, void* user) const noexcept = 0;
 
-  /// The same for the part λ ≤ max_lambda of the line (a caller after the first crossing up to
-  /// a bound): every triangle crossed there is visited; those beyond may be visited or not. The
-  /// default visits the whole line; an implementation prunes the rest.
-  virtual void for_each_line_candidate_up_to(const Vector3& origin, const Vector3& direction,
-                                             double max_lambda, Visitor visit,
-                                             void* user) const noexcept {
+  /// Called like Visitor; returns whether the caller found the triangle crossed (its exact
+  /// test), which lets the caster skip every triangle beyond that crossing. Must not throw.
+  using CrossingVisitor = bool (*)(void* user, int triangle) noexcept;
+
+  /// For a caller after the first crossing at λ ≤ max_lambda (a line's entry, up to a bound):
+  /// visits every triangle crossed at λ ≤ max_lambda that lies before, or within rounding of,
+  /// each crossing `visit` confirmed; triangles beyond may be visited or not. The default
+  /// visits the whole line; an implementation prunes the rest.
+  virtual void for_each_first_crossing_candidate(const Vector3& origin, const Vector3& direction,
+                                                 double max_lambda, CrossingVisitor visit,
+                                                 void* user) const noexcept {
     static_cast<void>(max_lambda);
-    for_each_line_candidate(origin, direction, visit, user);
+    struct Adapter {
+      CrossingVisitor visit;
+      void* user;
+    } adapter{visit, user};
+    for_each_line_candidate(
+        origin, direction,
+        [](void* a, int triangle) noexcept {
+          const auto* ad = static_cast<const Adapter*>(a);
+          static_cast<void>(ad->visit(ad->user, triangle));
+        },
+        &adapter);
   }
 };
 

@@ -99,8 +99,10 @@ enum class OnMiss {
 /// The entry of the same line (its smallest-λ crossing with the shapes of `body`) for a caller
 /// that compares entries up to a bound, as isolation does: false when the line crosses no shape
 /// at λ ≤ max_lambda; else the entry, the same as intersect_line_with_body's whenever that lies
-/// at λ ≤ max_lambda (a crossing beyond the bound may be returned or not). Cheaper: meshes are
-/// searched only up to the bound and to the nearest entry found so far, and no exit is sought.
+/// at λ ≤ max_lambda (bit for bit, but where two triangles are crossed within float rounding of
+/// each other either may be the one reported); a crossing beyond the bound may be returned or
+/// not. Cheaper: meshes are searched by a closest-hit traversal, only up to the bound and the
+/// nearest entry found so far, and no exit is sought.
 /// Real-time safe: noexcept, no allocation, bounded time.
 [[nodiscard]] bool first_entry_on_body(const GeometryModel& geometry, int body, const Pose& X_WB,
                                        const Vector3& point_on_line_W, const Vector3& direction_W,
