@@ -389,9 +389,9 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
     return;
   }
   out_.link = link;
-  WrenchFit fit;  // nothing estimated on a bad q̈̂
-  if (out_.status.ok()) fit = table_one_case(link, base, flags);  // 8
-  contact_point(link, fit, det.contact, flags);                   // 9
+  static const WrenchFit kNoFit;  // nothing estimated on a bad q̈̂
+  const WrenchFit& fit = out_.status.ok() ? table_one_case(link, base, flags) : kNoFit;  // 8
+  contact_point(link, fit, det.contact, flags);                                          // 9
   consistency(t, link, det.contact, fit, flags);
   if (noise_.configured) uncertainty(link, fit, flags);  // 10
   release_point_L_ = out_.point_L.allFinite() ? out_.point_L : Vector3::Zero();
@@ -475,19 +475,27 @@ int ContactEstimator::geometric_isolation(int residual_link, const BaseWrench& b
 // 8. In: the isolated link, the base wrench of stage 5, data_ (poses). Out: J_ = J_l of O_l,
 // the fit of the sensor's Table I case; out_.condition_number, out_.force_W (case E) and the
 // kForce, kIllConditioned, kUnobservable flags.
-WrenchFit ContactEstimator::table_one_case(int link, const BaseWrench& base,
-                                           std::uint32_t& flags) noexcept {
+const WrenchFit& ContactEstimator::table_one_case(int link, const BaseWrench& base,
+                                                  std::uint32_t& flags) noexcept {
   const Vector3& O_l = data_.X_WB[static_cast<std::size_t>(link)].translation;
-  point_jacobian(model_, data_, link, O_l, J_);  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l
+  // J_l of O_l: [J_v,l; J_ω,l], zero beyond l. Geometric isolation computed it when the link was
+  // its last candidate: the same bits, taken over by a swap of the buffers.
+  if (link == geometric_link_ && isolation_ws_.jacobian_link == link) {
+    J_.swap(isolation_ws_.J);
+    isolation_ws_.jacobian_link = -1;
+  } else {
+    point_jacobian(model_, data_, link, O_l, J_);
+  }
   // Geometric isolation made this very solve already (same J_l, τ̂ and warm start): take it over.
   // A link chosen along another candidate's line takes that candidate's fit (isolation.hpp).
   const auto l = static_cast<std::size_t>(link);
   const bool borrowed = link == geometric_link_ && isolation_ws_.tested[l].borrowed;
   const bool solved = link == geometric_link_ && (link == spectrum_link_ || borrowed);
-  WrenchFit fit =
-      solved ? isolation_ws_.tested[l].fit
-             : wrench_case(options_.sensor.type, J_, link, tau_ext_, base, O_l,
-                           options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
+  WrenchFit& fit = solved ? isolation_ws_.tested[l].fit : fit_;
+  if (!solved) {
+    fit_wrench_case(fit, options_.sensor.type, J_, link, tau_ext_, base, O_l,
+                    options_.sensor.X_WS.translation, options_.solver, b_, spectrum_);
+  }
   if (solved && !borrowed) spectrum_ = isolation_ws_.guess[l];
   spectrum_link_ = borrowed ? -1 : link;  // no warm start of this link's own solve
   if (options_.sensor.type != SensorType::kForceTorque) out_.condition_number = fit.condition;

@@ -43,11 +43,12 @@ double test_candidate(const Model& model, const Data& data, int l, const Isolati
   const Pose& X_WL = data.X_WB[static_cast<std::size_t>(l)];
   const Vector3& O_l = X_WL.translation;
   point_jacobian(model, data, l, O_l, ws.J);
+  ws.jacobian_link = l;
   TestedCandidate& t = ws.tested[static_cast<std::size_t>(l)];
   t.has_entry = false;
   t.borrowed = false;
-  t.fit = wrench_case(in.sensor, ws.J, l, *in.tau_ext, *in.base, O_l, in.p_WS, solver, ws.b,
-                      ws.guess[static_cast<std::size_t>(l)], false);
+  fit_wrench_case(t.fit, in.sensor, ws.J, l, *in.tau_ext, *in.base, O_l, in.p_WS, solver, ws.b,
+                  ws.guess[static_cast<std::size_t>(l)], false);
   if (!t.fit.ok) return kInf;
   testable = true;
   double misfit = kInf;
@@ -97,6 +98,7 @@ IsolationResult isolate_on_geometry(const Model& model, const Data& data,
   res.link = in.residual_link;
   if (in.residual_link < 0) return res;
   ws.tolerance = options.tolerance * *in.tau_min;
+  ws.jacobian_link = -1;
   // Candidate links are bodies l_r … last; at most 64 fit the candidate mask.
   const int last =
       std::min({model.num_bodies() - 1, static_cast<int>(geometry.body_shapes.size()) - 1, 63});

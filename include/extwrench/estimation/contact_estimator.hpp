@@ -110,7 +110,8 @@ class ContactEstimator {
   void estimate(double t, const Eigen::Ref<const VectorX>& dq,
                 const Vector6& reading_S) noexcept;  // stages 5–9
   BaseWrench base_sensor_reading(const Vector6& reading_S, std::uint32_t& flags) noexcept;
-  WrenchFit table_one_case(int link, const BaseWrench& base, std::uint32_t& flags) noexcept;
+  /// The fit is fit_ or the chosen candidate's (valid until the next update).
+  const WrenchFit& table_one_case(int link, const BaseWrench& base, std::uint32_t& flags) noexcept;
   /// The sensor's force now, for the release (NaN when unknown): the smaller of the two routes
   /// (`either`) and the one with q̈ measured (`measured`, independent of the contact point).
   struct ReleaseForces {
@@ -182,6 +183,7 @@ class ContactEstimator {
   bool ddq_supplied_ = false;  ///< this sample's q̈̂ came from the caller (update_with)
   /// B⁻¹ [J_vᵀ r] (n×4, row-major: one row operation per step of the substitutions), release
   Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> minv_jvt_r_;
+  WrenchFit fit_;  ///< stage 8's fit when isolation did not make it
   ContactEstimate out_;
   // LDLᵀ of B(q) for q̈̂ with storage inside the object (up to kInlineJoints joints): the
   // fixed-capacity factorisation and solves are faster than the dynamic-size ones in Data.

@@ -75,6 +75,7 @@ struct TestedCandidate {
 struct IsolationWorkspace {
   explicit IsolationWorkspace(const Model& model);
   Matrix6X J;                           ///< J_l of a candidate, 6×n
+  int jacobian_link = -1;               ///< the candidate J is of (the last one tested), or −1
   VectorX b, tau_pred, tolerance;       ///< (n)
   std::vector<SpectrumGuess> guess;     ///< per candidate link: warm start of the damped solves
   std::vector<TestedCandidate> tested;  ///< per link: valid for the chosen link of the last call

@@ -33,6 +33,7 @@ struct WrenchFit {
   /// partial: the force alone at a known point (no sensor, J_v,pᵀ F = τ̂), basis_W's top-left.
   bool point_force = false;
   int rank = 0;
+  /// Meaningful only when `partial` (fit_wrench_case leaves it as it was otherwise).
   Eigen::Matrix<double, 6, 6> basis_W = Eigen::Matrix<double, 6, 6>::Zero();
 };
 
@@ -66,16 +67,25 @@ inline void partial_wrench(const Jacobian& J, int link, const VectorX& tau_ext,
 
 /// Table I case stage. In: the sensor type, J = J_l (6×n), l, τ̂_ext (n), the base wrench
 /// (F̂, n_m − ñ_g of base_wrench; unused for kNone), O_l, the sensor origin p_WS, the solver
-/// options. Scratch: b (n), the spectrum guess of the damped solves. Out: the fit; when the rank
-/// test fails and observable_part, its observable part (partial_moment, partial_wrench).
+/// options. Scratch: b (n), the spectrum guess of the damped solves. Out: `fit`, every field set
+/// (basis_W only when partial: a fit reused in the loop costs no 6×6 copy or zeroing); when the
+/// rank test fails and observable_part, its observable part (partial_moment, partial_wrench).
 template <typename Jacobian>
-[[nodiscard]] inline WrenchFit wrench_case(SensorType type, const Jacobian& J, int link,
-                                           const VectorX& tau_ext, const BaseWrench& base,
-                                           const Vector3& O_l, const Vector3& p_WS,
-                                           const SolverOptions& solver, VectorX& b,
-                                           SpectrumGuess& guess,
-                                           bool observable_part = true) noexcept {
-  WrenchFit fit;
+inline void fit_wrench_case(WrenchFit& fit, SensorType type, const Jacobian& J, int link,
+                            const VectorX& tau_ext, const BaseWrench& base, const Vector3& O_l,
+                            const Vector3& p_WS, const SolverOptions& solver, VectorX& b,
+                            SpectrumGuess& guess, bool observable_part = true) noexcept {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  fit.force_W.setConstant(kNaN);
+  fit.moment_O.setConstant(kNaN);
+  fit.ok = false;
+  fit.damped = false;
+  fit.fitted_force = false;
+  fit.condition = kNaN;
+  fit.damping = 0.0;
+  fit.partial = false;
+  fit.point_force = false;
+  fit.rank = 0;
   if (type == SensorType::kForceTorque) {
     // C (17): M̃ = n_m − ñ_g − r_{s,l} × F̂, the moment about O_l.
     fit.force_W = base.force_W;
@@ -114,6 +124,18 @@ template <typename Jacobian>
       fit.fitted_force = fit.rank > 0;
     }
   }
+}
+
+/// The same, returned by value.
+template <typename Jacobian>
+[[nodiscard]] inline WrenchFit wrench_case(SensorType type, const Jacobian& J, int link,
+                                           const VectorX& tau_ext, const BaseWrench& base,
+                                           const Vector3& O_l, const Vector3& p_WS,
+                                           const SolverOptions& solver, VectorX& b,
+                                           SpectrumGuess& guess,
+                                           bool observable_part = true) noexcept {
+  WrenchFit fit;
+  fit_wrench_case(fit, type, J, link, tau_ext, base, O_l, p_WS, solver, b, guess, observable_part);
   return fit;
 }
 
