@@ -48,12 +48,20 @@ ShapeClosestPoint closest_on_miss(const CollisionShape& shape, const Vector3& o,
   return mesh_closest_on_miss(*shape.mesh, o, u);
 }
 
-// The line in the frame G of a shape of the body posed at X_WB: X_WG, o_G, u_G.
-void line_in_shape(const CollisionShape& shape, const Pose& X_WB, const Vector3& point_W,
-                   const Vector3& u_W, Pose& X_WG, Vector3& o_G, Vector3& u_G) noexcept {
-  X_WG = X_WB * shape.placement;
-  o_G.noalias() = X_WG.rotation.transpose() * (point_W - X_WG.translation);
-  u_G.noalias() = X_WG.rotation.transpose() * u_W;
+// Calls visit(s, shape, X_WG, o_G, u_G) for every valid shape s of `body` (an index the caller
+// checked): its pose X_WG = X_WB · placement and the line (point_W, unit u_W) in its frame G.
+template <typename Visit>
+void for_each_posed_shape(const GeometryModel& geometry, int body, const Pose& X_WB,
+                          const Vector3& point_W, const Vector3& u_W, Visit&& visit) noexcept {
+  const int num_shapes = static_cast<int>(geometry.shapes.size());
+  for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
+    if (s < 0 || s >= num_shapes) continue;
+    const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
+    const Pose X_WG = X_WB * shape.placement;
+    const Vector3 o_G = X_WG.rotation.transpose() * (point_W - X_WG.translation);
+    const Vector3 u_G = X_WG.rotation.transpose() * u_W;
+    visit(s, shape, X_WG, o_G, u_G);
+  }
 }
 
 // A hit of shape s in W. Mesh winding may be inward: the entry faces −u (orient −1), the exit
@@ -116,26 +124,22 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
   if (!usable_line(X_WB, point_on_line_W, direction_W, u_W)) return result;
   result.distance = kInf;
   if (body < 0 || body >= static_cast<int>(geometry.body_shapes.size())) return result;
-  const int num_shapes = static_cast<int>(geometry.shapes.size());
 
   std::array<ShapeHit, kMaxHitsPerShape> buffer;
-  for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
-    if (s < 0 || s >= num_shapes) continue;
-    const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
-    Pose X_WG;
-    Vector3 o_G, u_G;
-    line_in_shape(shape, X_WB, point_on_line_W, u_W, X_WG, o_G, u_G);
-    HitSink sink(buffer);
-    collect_hits(shape, o_G, u_G, sink);
-    if (sink.distinct() == 0) continue;
-    result.num_hits += sink.distinct();
-    const bool is_mesh = shape.type == ShapeType::kMesh;
-    if (!result.hit || sink.first().lambda < result.entry.lambda)
-      result.entry = hit_in_world(sink.first(), X_WG, u_W, is_mesh, -1.0, s);
-    if (!result.hit || sink.last().lambda > result.exit.lambda)
-      result.exit = hit_in_world(sink.last(), X_WG, u_W, is_mesh, 1.0, s);
-    result.hit = true;
-  }
+  for_each_posed_shape(geometry, body, X_WB, point_on_line_W, u_W,
+                       [&](int s, const CollisionShape& shape, const Pose& X_WG, const Vector3& o_G,
+                           const Vector3& u_G) {
+                         HitSink sink(buffer);
+                         collect_hits(shape, o_G, u_G, sink);
+                         if (sink.distinct() == 0) return;
+                         result.num_hits += sink.distinct();
+                         const bool is_mesh = shape.type == ShapeType::kMesh;
+                         if (!result.hit || sink.first().lambda < result.entry.lambda)
+                           result.entry = hit_in_world(sink.first(), X_WG, u_W, is_mesh, -1.0, s);
+                         if (!result.hit || sink.last().lambda > result.exit.lambda)
+                           result.exit = hit_in_world(sink.last(), X_WG, u_W, is_mesh, 1.0, s);
+                         result.hit = true;
+                       });
 
   if (result.hit) {
     result.closest_point_W = result.entry.point_W;
@@ -145,20 +149,16 @@ SurfacePointResult intersect_line_with_body(const GeometryModel& geometry, int b
     return result;
   }
   if (on_miss == OnMiss::kNothing) return result;
-  for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
-    if (s < 0 || s >= num_shapes) continue;
-    const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
-    Pose X_WG;
-    Vector3 o_G, u_G;
-    line_in_shape(shape, X_WB, point_on_line_W, u_W, X_WG, o_G, u_G);
-    const ShapeClosestPoint cp = closest_on_miss(shape, o_G, u_G);
-    if (cp.distance < result.distance) {
-      result.distance = cp.distance;
-      result.closest_point_W = X_WG.act(cp.point_G);
-      result.closest_lambda = cp.lambda;
-      result.shape = s;
-    }
-  }
+  for_each_posed_shape(geometry, body, X_WB, point_on_line_W, u_W,
+                       [&](int s, const CollisionShape& shape, const Pose& X_WG, const Vector3& o_G,
+                           const Vector3& u_G) {
+                         const ShapeClosestPoint cp = closest_on_miss(shape, o_G, u_G);
+                         if (!(cp.distance < result.distance)) return;
+                         result.distance = cp.distance;
+                         result.closest_point_W = X_WG.act(cp.point_G);
+                         result.closest_lambda = cp.lambda;
+                         result.shape = s;
+                       });
   return result;
 }
 
@@ -168,25 +168,22 @@ bool first_entry_on_body(const GeometryModel& geometry, int body, const Pose& X_
   Vector3 u_W;
   if (!usable_line(X_WB, point_on_line_W, direction_W, u_W)) return false;
   if (body < 0 || body >= static_cast<int>(geometry.body_shapes.size())) return false;
-  const int num_shapes = static_cast<int>(geometry.shapes.size());
   bool hit = false;
   // Only each shape's first hit is wanted: HitSink tracks it whatever its buffer holds.
   std::array<ShapeHit, 1> buffer;
-  for (const int s : geometry.body_shapes[static_cast<std::size_t>(body)]) {
-    if (s < 0 || s >= num_shapes) continue;
-    const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
-    Pose X_WG;
-    Vector3 o_G, u_G;
-    line_in_shape(shape, X_WB, point_on_line_W, u_W, X_WG, o_G, u_G);
-    HitSink sink(buffer);
-    // Beyond the entry found so far this shape cannot come first.
-    collect_hits(shape, o_G, u_G, sink, true,
-                 hit ? std::min(max_lambda, entry.lambda) : max_lambda);
-    if (sink.distinct() == 0) continue;
-    if (!hit || sink.first().lambda < entry.lambda)
-      entry = hit_in_world(sink.first(), X_WG, u_W, shape.type == ShapeType::kMesh, -1.0, s);
-    hit = true;
-  }
+  for_each_posed_shape(geometry, body, X_WB, point_on_line_W, u_W,
+                       [&](int s, const CollisionShape& shape, const Pose& X_WG, const Vector3& o_G,
+                           const Vector3& u_G) {
+                         HitSink sink(buffer);
+                         // Beyond the entry found so far this shape cannot come first.
+                         collect_hits(shape, o_G, u_G, sink, true,
+                                      hit ? std::min(max_lambda, entry.lambda) : max_lambda);
+                         if (sink.distinct() == 0) return;
+                         if (!hit || sink.first().lambda < entry.lambda)
+                           entry = hit_in_world(sink.first(), X_WG, u_W,
+                                                shape.type == ShapeType::kMesh, -1.0, s);
+                         hit = true;
+                       });
   return hit;
 }
 
