@@ -34,12 +34,9 @@ ContactEstimator::ReleaseForces ContactEstimator::sensor_release_forces(
   const Vector3 p_W = X_WL.act(release_point_L_);
   const bool moments = base.dn_W.allFinite();
   const Vector3& p_s = options_.sensor.X_WS.translation;
-  // B⁻¹ [J_vᵀ r]: row j−1 of J_vᵀ is s_v + s_ω × p for the joints j that move p, else 0.
-  minv_jvt_r_.leftCols<3>().setZero();
-  for (int j = release_link_; j > 0; j = model_.parents[static_cast<std::size_t>(j)]) {
-    const Vector6& s = data_.S[static_cast<std::size_t>(j)];
-    minv_jvt_r_.row(j - 1).head<3>() = (s.head<3>() + s.tail<3>().cross(p_W)).transpose();
-  }
+  // B⁻¹ [J_vᵀ r], J_v of p (J_ is scratch until stage 8).
+  point_jacobian(model_, data_, release_link_, p_W, J_);
+  minv_jvt_r_.leftCols<3>() = J_.topRows<3>().transpose();
   minv_jvt_r_.col(3) = observer_.residual();
   if (n_ <= kInlineJoints) {
     ldlt_solve_columns(mass_ldlt_, minv_jvt_r_);

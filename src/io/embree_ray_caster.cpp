@@ -60,7 +60,7 @@ struct QueryContext {
 /// Reports every hit Embree finds. A plain query rejects each, so traversal goes on to the next
 /// one: one rtcIntersect1 call then visits all crossed triangles. A first-crossing query accepts
 /// the hits its visitor confirms: Embree then looks only for nearer ones (closest-hit traversal).
-void report_and_reject(const RTCFilterFunctionNArguments* args) {
+void report_hit(const RTCFilterFunctionNArguments* args) {
   const auto* query = reinterpret_cast<const QueryContext*>(args->context);
   for (unsigned int i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
@@ -111,7 +111,7 @@ class EmbreeRayCaster final : public MeshRayCaster {
     for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
       for (int k = 0; k < 3; ++k) ib[3 * t + k] = static_cast<unsigned>(triangles(k, t));
     }
-    rtcSetGeometryIntersectFilterFunction(geometry.get(), &report_and_reject);
+    rtcSetGeometryIntersectFilterFunction(geometry.get(), &report_hit);
     rtcCommitGeometry(geometry.get());
     rtcAttachGeometry(scene_.get(), geometry.get());  // the scene keeps its own reference
     rtcCommitScene(scene_.get());
