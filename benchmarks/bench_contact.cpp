@@ -175,6 +175,17 @@ void register_contact_benchmarks() {
           run_update(state, arm.model, arm.geometry, o, link6);
         });
   }
+  // The residual filter (observer.residual_cutoff, 20 Hz on every joint): its per-sample cost
+  // against the plain update above in the same binary.
+  for (const Config& c : {kTableI[0], kTableI[4]}) {
+    benchmark::RegisterBenchmark(
+        (std::string("BM_FullUpdate_Ours/") + c.name + "/capsules/residual_filter").c_str(),
+        [&arm, &link6, c](benchmark::State& state) {
+          EstimatorOptions o = options_for(c, link6);
+          o.residual_cutoff = VectorX::Constant(1, 20.0);
+          run_update(state, arm.model, arm.geometry, o, link6);
+        });
+  }
   if (const MeshArm* panda = panda_arm(); panda != nullptr) {
     const Trajectory& tr = *panda_trajectory();
     for (const Config& c : {kTableI[0], kTableI[4]}) {

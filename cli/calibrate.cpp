@@ -1,7 +1,10 @@
 // extwrench calibrate: friction, offsets, sensor bias, noise and thresholds from a contact-free
 // log (docs/calibration.md), written as CALIB.yaml for `calibration:` in a configuration.
+#include <array>
 #include <chrono>
+#include <cstdio>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 
@@ -36,74 +39,104 @@ std::vector<Sample> read_log(const std::filesystem::path& path, const Model& mod
   return samples;
 }
 
+// The report's numbers: four significant digits, right-aligned in `width` columns (the exact
+// values are in CALIB.yaml).
+std::string cell(double value, int width = 8) {
+  std::array<char, 40> text{};
+  std::snprintf(text.data(), text.size(), "%*.4g", width, value == 0.0 ? 0.0 : value);
+  return text.data();
+}
+
+std::string cells(const Vector3& v) {
+  return "(" + cell(v.x(), 0) + ", " + cell(v.y(), 0) + ", " + cell(v.z(), 0) + ")";
+}
+
 void print_report(const Calibration& c, const HoldoutReport* h, bool in_contact) {
-  std::cout << "  joint  viscous  coulomb   offset   v_s    rms before -> after  var.expl  "
-               "threshold\n";
+  std::cout << "  joint  viscous  Coulomb   offset      v_s  RMS before ->  after  var.expl  "
+               "threshold [N m]\n";
   for (std::size_t i = 0; i < c.joints.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     const JointFitReport& j = c.joints[i];
-    std::cout << "  " << i + 1 << "      " << fmt(c.friction.viscous[k]) << "  "
-              << fmt(c.friction.coulomb[k]) << "  " << fmt(c.friction.offset[k]) << "  "
-              << fmt(c.friction.smoothing(k)) << "  " << fmt(j.rms_before) << " -> "
-              << fmt(j.rms_after) << "  " << fmt(j.variance_explained) << "  " << fmt(j.threshold);
+    std::cout << "  " << std::left << std::setw(5) << i + 1 << std::right
+              << cell(c.friction.viscous[k]) << " " << cell(c.friction.coulomb[k]) << " "
+              << cell(c.friction.offset[k]) << " " << cell(c.friction.smoothing(k)) << "  "
+              << cell(j.rms_before) << " -> " << cell(j.rms_after, 6) << "  "
+              << cell(j.variance_explained) << "  " << cell(j.threshold, 0);
     if (j.speed_dependent)
-      std::cout << " + " << fmt(j.threshold_per_speed) << " |dq| (constant would be "
-                << fmt(j.threshold_constant) << ")";
+      std::cout << " + " << cell(j.threshold_per_speed, 0) << " |dq| (constant would be "
+                << cell(j.threshold_constant, 0) << ")";
     std::cout << (j.threshold_from_max ? " (largest residual)" : " (gaussian)") << "\n";
   }
+  if ((c.residual_cutoff.array() > 0.0).any()) {
+    std::cout << "  residual filter [Hz]:";
+    for (Eigen::Index i = 0; i < c.residual_cutoff.size(); ++i)
+      std::cout << " " << cell(c.residual_cutoff[i], 0);
+    std::cout << " (RMS, noise and thresholds are of the filtered residual)\n";
+  }
   if (c.sensor_type != SensorType::kNone) {
-    std::cout << "  sensor bias [f; n] (S): " << fmt(Vector3(c.sensor_bias_S.head<3>())) << " N, "
-              << fmt(Vector3(c.sensor_bias_S.tail<3>())) << " N m; F_min " << fmt(c.force_threshold)
-              << " N\n";
+    std::cout << "  sensor bias [f; n] (S): " << cells(Vector3(c.sensor_bias_S.head<3>())) << " N, "
+              << cells(Vector3(c.sensor_bias_S.tail<3>())) << " N m; F_min "
+              << cell(c.force_threshold, 0) << " N\n";
   }
   if (c.payload.identified) {
-    std::cout << "  payload on link " << c.payload.body << ": " << fmt(c.payload.mass)
-              << " kg, CoM " << fmt(c.payload.com) << " m (link frame); sensor RMS per axis "
-              << fmt(Vector3(c.payload.rms_before.head<3>())) << " N "
-              << fmt(Vector3(c.payload.rms_before.tail<3>())) << " N m -> "
-              << fmt(Vector3(c.payload.rms_after.head<3>())) << " N "
-              << fmt(Vector3(c.payload.rms_after.tail<3>())) << " N m\n";
+    std::cout << "  payload on link " << c.payload.body << ": " << cell(c.payload.mass, 0)
+              << " kg, CoM " << cells(c.payload.com) << " m (link frame); sensor RMS per axis "
+              << cells(Vector3(c.payload.rms_before.head<3>())) << " N "
+              << cells(Vector3(c.payload.rms_before.tail<3>())) << " N m -> "
+              << cells(Vector3(c.payload.rms_after.head<3>())) << " N "
+              << cells(Vector3(c.payload.rms_after.tail<3>())) << " N m\n";
   }
   std::cout << "  model check: residual RMS per joint before calibration [";
   for (Eigen::Index i = 0; i < c.model_check.joint_rms.size(); ++i)
-    std::cout << (i ? " " : "") << fmt(c.model_check.joint_rms[i]);
+    std::cout << (i ? " " : "") << cell(c.model_check.joint_rms[i], 0);
   std::cout << "] N m";
   if (c.sensor_type != SensorType::kNone)
-    std::cout << "; sensor error RMS " << fmt(Vector3(c.model_check.sensor_rms.head<3>())) << " N "
-              << fmt(Vector3(c.model_check.sensor_rms.tail<3>())) << " N m";
+    std::cout << "; sensor error RMS " << cells(Vector3(c.model_check.sensor_rms.head<3>()))
+              << " N " << cells(Vector3(c.model_check.sensor_rms.tail<3>())) << " N m";
   std::cout << "\n";
   for (const ModelPattern& p : c.model_check.patterns) std::cout << "    " << p.message << "\n";
   if (c.model_check.patterns.empty()) std::cout << "    no recognisable model error\n";
   for (const std::string& w : c.warnings)
     std::cerr << "extwrench calibrate: warning: " << w << "\n";
   if (h == nullptr) return;
-  std::cout << "  holdout: " << h->samples << " samples (" << fmt(h->duration)
+  std::cout << "  holdout: " << h->samples << " samples (" << cell(h->duration, 0)
             << " s): " << h->false_alarms
             << (in_contact ? " samples with contact declared (the log is in contact: not false "
                              "alarms) ("
                            : " false-alarm samples (")
-            << fmt(h->samples ? 100.0 * h->false_alarms / h->samples : 0.0) << " %), uncalibrated "
-            << h->uncalibrated_false_alarms << ", calibrated with constant thresholds "
-            << h->constant_threshold_false_alarms << "\n"
-            << "  joint  calibrated threshold | smallest quiet constant: uncalibrated  "
-               "calibrated\n";
+            << cell(h->samples ? 100.0 * h->false_alarms / h->samples : 0.0, 0)
+            << " %), uncalibrated " << h->uncalibrated_false_alarms
+            << ", calibrated with constant thresholds " << h->constant_threshold_false_alarms
+            << "\n"
+            << "  joint " << std::setw(22) << "calibrated threshold"
+            << " | smallest quiet constant: " << std::setw(12) << "uncalibrated" << std::setw(12)
+            << "calibrated"
+            << "  [N m]\n";
   for (Eigen::Index i = 0; i < h->calibrated_threshold.size(); ++i)
-    std::cout << "  " << i + 1 << "      " << fmt(h->calibrated_threshold[i]) << " | "
-              << fmt(h->best_constant_threshold[i]) << "  " << fmt(h->calibrated_max_residual[i])
+    std::cout << "  " << std::left << std::setw(6) << i + 1 << std::right
+              << cell(h->calibrated_threshold[i], 22) << " | " << std::setw(26) << ""
+              << cell(h->best_constant_threshold[i], 12) << cell(h->calibrated_max_residual[i], 12)
               << "\n";
-  std::cout << "  link   smallest detectable force at " << fmt(h->lever)
-            << " m [N] (median): calibrated thresholds (constant form) | smallest quiet "
-               "constant: uncalibrated  calibrated\n";
+  std::cout << "  smallest force detectable at " << cell(h->lever, 0)
+            << " m [N] (median over the holdout), with\n"
+            << "  link " << std::setw(23) << "calibrated thresholds" << std::setw(16)
+            << "(constant form)"
+            << " | smallest quiet constant: " << std::setw(12) << "uncalibrated" << std::setw(12)
+            << "calibrated"
+            << "\n";
   for (std::size_t l = 1; l < h->min_force_calibrated.size(); ++l)
-    std::cout << "  " << l << "      " << fmt(h->min_force_calibrated[l]) << " ("
-              << fmt(h->min_force_calibrated_constant[l]) << ") | " << fmt(h->min_force_constant[l])
-              << "  " << fmt(h->min_force_calibrated_quiet[l]) << "\n";
+    std::cout << "  " << std::left << std::setw(5) << l << std::right
+              << cell(h->min_force_calibrated[l], 23)
+              << cell(h->min_force_calibrated_constant[l], 16) << " | " << std::setw(26) << ""
+              << cell(h->min_force_constant[l], 12) << cell(h->min_force_calibrated_quiet[l], 12)
+              << "\n";
   if (h->tracking_rms_calibrated.size() == 0) return;
   std::cout << "  joint  RMS of residual - true_tau_ext on the holdout [N m]: uncalibrated -> "
                "calibrated\n";
   for (Eigen::Index i = 0; i < h->tracking_rms_calibrated.size(); ++i)
-    std::cout << "  " << i + 1 << "      " << fmt(h->tracking_rms_uncalibrated[i]) << " -> "
-              << fmt(h->tracking_rms_calibrated[i]) << "\n";
+    std::cout << "  " << std::left << std::setw(5) << i + 1 << std::right
+              << cell(h->tracking_rms_uncalibrated[i]) << " -> "
+              << cell(h->tracking_rms_calibrated[i]) << "\n";
 }
 
 void run_calibrate(const CalibrateOptions& opt) {
@@ -161,7 +194,7 @@ void run_calibrate(const CalibrateOptions& opt) {
   out << calibration_to_yaml(cal, holdout ? &*holdout : nullptr);
   if (!out) throw Error(opt.out.string() + ": write failed");
   std::cout << "extwrench calibrate: " << samples.size() << " rows, fit on " << fit.size() << " ("
-            << cal.samples_used << " used) in " << fmt(seconds) << " s -> " << opt.out.string()
+            << cal.samples_used << " used) in " << cell(seconds, 0) << " s -> " << opt.out.string()
             << "\n";
   print_report(cal, holdout ? &*holdout : nullptr, opt.known_torque);
 }

@@ -7,6 +7,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
+#include "extwrench/observer/residual_filter.hpp"
 #include "friction_fit.hpp"
 #include "model_check.hpp"
 #include "payload_fit.hpp"
@@ -342,8 +343,23 @@ void exclude_windows(const std::vector<SuspectWindow>& windows, const std::vecto
       if (samples[k].t >= w.t_begin - kWindowGap && samples[k].t <= w.t_end + settle) use[k] = 0;
 }
 
+/// The residual filter (residual_filter.hpp) over a joint's residual series, from rest at 0 as
+/// the estimator's after a reset at the first sample: the same steps, so the same bits.
+std::vector<double> filtered_residual(std::vector<double> r, const std::vector<Sample>& samples,
+                                      double cutoff) {
+  if (!(cutoff > 0.0)) return r;
+  double s1 = 0.0, s2 = 0.0;
+  for (std::size_t k = 1; k < r.size(); ++k) {
+    const double w = residual_filter_weight(cutoff, samples[k].t - samples[k - 1].t);
+    r[k] = residual_filter_step(w, r[k], s1, s2);
+  }
+  return r;
+}
+
 /// The fitted friction and offsets into `cal`, and per joint the residual's threshold for the
-/// false-alarm rate, before (r0, the model's own friction) and after the fit.
+/// false-alarm rate, before (r0, the model's own friction) and after the fit. The thresholds,
+/// noise and RMS are those of the residual as the detector sees it (through the residual filter
+/// at cal.residual_cutoff); the fit itself is on the observer's residual.
 void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
                              const std::vector<JointSeries>& series,
                              const std::vector<JointSeries>& before,
@@ -370,14 +386,18 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
     JointFitReport j;
     j.condition = f.condition;
     JointFitReport b;
-    joint_threshold(before[static_cast<std::size_t>(i)].r0, samples, use, rate, 1.0, b);
+    joint_threshold(
+        filtered_residual(before[static_cast<std::size_t>(i)].r0, samples, cal.residual_cutoff[i]),
+        samples, use, rate, 1.0, b);
     j.rms_before = b.rms_after;
     j.max_before = b.max_after;
-    joint_threshold(f.residual, samples, use, rate, o.threshold_margin, j);
+    const std::vector<double> residual =
+        filtered_residual(f.residual, samples, cal.residual_cutoff[i]);
+    joint_threshold(residual, samples, use, rate, o.threshold_margin, j);
     j.variance_explained =
         b.noise_std > 0 ? 1.0 - (j.noise_std * j.noise_std) / (b.noise_std * b.noise_std) : 0.0;
     j.threshold_constant = j.threshold;
-    speed_threshold(f.residual, series[static_cast<std::size_t>(i)].dq, samples, use, rate,
+    speed_threshold(residual, series[static_cast<std::size_t>(i)].dq, samples, use, rate,
                     o.threshold_margin, j);
     j.speed_dependent = j.threshold_per_speed > 0.0 &&
                         (o.thresholds == ThresholdModel::kSpeed ||
@@ -463,6 +483,9 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   }
 
   cal.observer_gain = gains;
+  cal.residual_cutoff = options.residual_cutoff.size() == 1
+                            ? VectorX::Constant(n, options.residual_cutoff[0])
+                            : options.residual_cutoff;
   cal.sensor_type = options.sensor.type;
   cal.false_alarms_per_hour = o.false_alarms_per_hour;
   cal.t_begin = samples.front().t;
@@ -512,7 +535,10 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
       const VectorX& g = gravity_torques(m, data, samples[k].q);
       for (int i = 0; i < n; ++i) gravity[static_cast<std::size_t>(i)][k] = g[i];
     }
-    calibration_detail::check_joints(series, before, fits, gravity, use, cal.model_check);
+    std::vector<double> times(samples.size());
+    for (std::size_t k = 0; k < samples.size(); ++k) times[k] = samples[k].t;
+    calibration_detail::check_joints(series, before, fits, gravity, times, cal.residual_cutoff, use,
+                                     cal.model_check);
   }
   if (options.sensor.type != SensorType::kNone)
     sensor_calibration(model, options, samples, use, o, cal);
@@ -551,6 +577,8 @@ EstimatorOptions apply_calibration(EstimatorOptions options, const Calibration& 
                 std::to_string(options.payload->body));
   }
   options.friction = calibration.friction;
+  if (calibration.residual_cutoff.size() > 0)  // the thresholds are for its output
+    options.residual_cutoff = calibration.residual_cutoff;
   options.detection.tau_min = calibration.tau_threshold;
   options.detection.tau_per_speed = calibration.tau_per_speed;
   if (calibration.sensor_type != SensorType::kNone && calibration.force_threshold > 0) {

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+
+#include "extwrench/observer/residual_filter.hpp"
 
 namespace extwrench::calibration_detail {
 namespace {
@@ -13,6 +16,33 @@ constexpr double kJointShare = 0.3;
 constexpr double kPoseShare = 0.5;
 // A base-force offset is named when its mean exceeds this many standard deviations of the rest.
 constexpr double kOffsetSpreads = 2.0;
+// High-frequency residual: named when the residual filter at kSuggestedCutoff would leave at most
+// this share of the calibrated residual's variance (its spread would drop to ~55 %). White torque
+// noise, which the observer's own first-order law filters, leaves 45 % at K = 100 and more at
+// lower gains: a smaller share is noise that enters after that filter, through K B(q) δq̇.
+constexpr double kSuggestedCutoff = 20.0;  // [Hz]
+constexpr double kHighFrequencyLeft = 0.3;
+
+/// Variance over the used samples of r, and of r through the residual filter at `cutoff`.
+std::pair<double, double> variance_and_filtered(const std::vector<double>& r,
+                                                const std::vector<double>& times,
+                                                const std::vector<char>& use, double cutoff) {
+  double s1 = 0.0, s2 = 0.0, n = 0.0, sum = 0.0, sum2 = 0.0, fsum = 0.0, fsum2 = 0.0;
+  for (std::size_t k = 0; k < r.size(); ++k) {
+    const double f =
+        k == 0 ? 0.0
+               : residual_filter_step(residual_filter_weight(cutoff, times[k] - times[k - 1]), r[k],
+                                      s1, s2);
+    if (!use[k]) continue;
+    n += 1;
+    sum += r[k];
+    sum2 += r[k] * r[k];
+    fsum += f;
+    fsum2 += f * f;
+  }
+  if (n < 2) return {0.0, 0.0};
+  return {sum2 / n - (sum / n) * (sum / n), fsum2 / n - (fsum / n) * (fsum / n)};
+}
 
 std::string num(double x) {
   char b[32];
@@ -24,8 +54,8 @@ std::string num(double x) {
 
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
                   const std::vector<JointFrictionFit>& after,
-                  const std::vector<std::vector<double>>& gravity, const std::vector<char>& use,
-                  ModelCheck& check) {
+                  const std::vector<std::vector<double>>& gravity, const std::vector<double>& times,
+                  const VectorX& residual_cutoff, const std::vector<char>& use, ModelCheck& check) {
   const std::size_t n = series.size();
   check.joint_rms = VectorX::Zero(static_cast<Eigen::Index>(n));
   std::vector<double> phi, z;
@@ -61,6 +91,21 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
            "joint " + std::to_string(joint) + ": the calibrated residual follows g(q) (" +
                num(100.0 * g.slope) + " % of it, R^2 " + num(g.r2) +
                "): a gravity / mass error in the model (a payload? --payload with a F/T sensor)"});
+    }
+    // Mostly above ~20 Hz (unfiltered joints only): the velocity's noise through K B(q), or the
+    // torque's, which the residual filter removes (docs/estimator.md#residual-filter).
+    if (residual_cutoff[static_cast<Eigen::Index>(i)] > 0.0) continue;
+    const auto [variance, filtered] =
+        variance_and_filtered(after[i].residual, times, use, kSuggestedCutoff);
+    if (variance > 0.0 && filtered <= kHighFrequencyLeft * variance) {
+      const double share = 1.0 - filtered / variance;
+      check.patterns.push_back(
+          {"high_frequency", joint, share,
+           "joint " + std::to_string(joint) + ": " + num(100.0 * share) +
+               " % of the calibrated residual's variance lies above ~" + num(kSuggestedCutoff) +
+               " Hz (noise of dq through K B(q)): observer.residual_cutoff " +
+               num(kSuggestedCutoff) +
+               " (Hz) on this joint lowers its threshold (docs/estimator.md#residual-filter)"});
     }
   }
 }

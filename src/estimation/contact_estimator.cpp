@@ -23,12 +23,16 @@ constexpr double kTimeSlack = 1e-9;  // [s]
 // A residual / filter transient is over after this many time constants (e^{-5} < 1 %).
 constexpr double kSettleTimeConstants = 5.0;
 
-/// How long the residual (or the differentiation filter) takes to forget a force that ended.
+/// How long the residual (or the differentiation filter) takes to forget a force that ended,
+/// with the residual filter's two sections after it.
 double settle_time_of(const EstimatorOptions& options, const MomentumObserver& observer) {
   const double slowest = options.acceleration == AccelerationRoute::kResidual
                              ? 1.0 / observer.gains().minCoeff()
                              : 1.0 / (2.0 * std::numbers::pi * options.differentiation_cutoff);
-  return std::max(kSettleTimeConstants * slowest, options.detection.min_duration);
+  double filter = 0.0;  // the slowest filtered joint's two sections
+  for (const double cutoff : options.residual_cutoff)
+    if (cutoff > 0.0) filter = std::max(filter, 2.0 / (2.0 * std::numbers::pi * cutoff));
+  return std::max(kSettleTimeConstants * (slowest + filter), options.detection.min_duration);
 }
 
 }  // namespace
@@ -39,6 +43,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
       data_(model_),
       geometry_(std::move(geometry)),
       observer_(model_, options_.observer_gain),
+      residual_filter_(options_.residual_cutoff, model_.nq()),
       detector_(options_.detection, model_.nq(), settle_time_of(options_, observer_)),
       isolation_ws_(model_),
       noise_(make_noise_model(options_.uncertainty, model_.nq(), options_.sensor.X_WS.rotation)),
@@ -92,6 +97,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   dq_prev_ = dq;
   have_dq_prev_ = true;
   ddq_filtered_.setZero();
+  residual_filter_.reset();  // r = 0 at a reset
   detector_.reset();
   disagreement_on_ = false;
   have_disagreement_edge_ = false;
@@ -195,6 +201,7 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
   observer_.integrate(data_, t, q, dq, tau);      // 2 (validated above)
   out_.status = acceleration_route(dt, dq, tau);  // 3
   ground_wrench(dq);                              // 4
+  residual_filter_.apply(dt, tau_ext_);           // τ̂_ext low-passed (no-op by default)
   dq_prev_ = dq;
   t_ = t;
   estimate(t, dq, reading_S);  // 5–9
@@ -328,6 +335,8 @@ Status ContactEstimator::update_with(double t, const Eigen::Ref<const VectorX>& 
   ddq_supplied_ = true;
   root_wrench_dddq_valid_ = false;
   tau_ext_ = tau_ext;
+  if (!initialized_) residual_filter_.reset(tau_ext_);  // a start at rest on the first value
+  residual_filter_.apply(initialized_ ? t - t_ : 0.0, tau_ext_);
   rnea_no_kinematics(model_, data_, dq, ddq_);
   initialized_ = true;
   t_ = t;

@@ -32,6 +32,9 @@ void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   if (!(o.differentiation_cutoff > 0.0) || !std::isfinite(o.differentiation_cutoff)) {
     throw Error(where + ": acceleration cutoff: expected a finite value > 0 [Hz]");
   }
+  if (!(o.residual_cutoff.array() >= 0.0).all() || !o.residual_cutoff.allFinite()) {
+    throw Error(where + ": observer.residual_cutoff: expected finite values >= 0 [Hz] (0: none)");
+  }
   if (!(o.solver.max_condition > 1.0) || !std::isfinite(o.solver.max_condition)) {
     throw Error(where + ": solver.max_condition: expected a finite value > 1");
   }
@@ -108,6 +111,10 @@ void validate(const EstimatorOptions& o, const Model& model) {
   validate_friction(JointFriction::from_model(model), n,
                     "MomentumObserver: model '" + model.name + "'");
   validate(o.detection, n);
+  if (o.residual_cutoff.size() != 1 && o.residual_cutoff.size() != n) {
+    throw Error(where + ": observer.residual_cutoff: expected 1 or " + std::to_string(n) +
+                " values, got " + std::to_string(o.residual_cutoff.size()));
+  }
   if (o.friction) validate_friction(*o.friction, n, "MomentumObserver");
   if (o.payload && !finite_inertia(o.payload->inertia)) {
     throw Error(where + ": payload: non-finite or negative mass properties");

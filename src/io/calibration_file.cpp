@@ -147,7 +147,10 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
     << "# configuration with `calibration: THIS_FILE`.\n";
   y << "calibration: {version: 1, source: " << quoted(c.source) << ", t_begin: " << c.t_begin
     << ", t_end: " << c.t_end << ", false_alarms_per_hour: " << c.false_alarms_per_hour << "}\n";
-  y << "observer: {gain: " << yaml_list(c.observer_gain) << "}\n";
+  y << "observer: {gain: " << yaml_list(c.observer_gain);
+  if ((c.residual_cutoff.array() > 0.0).any())
+    y << ", residual_cutoff: " << yaml_list(c.residual_cutoff);
+  y << "}\n";
   y << "friction: " << io_detail::friction_mapping_yaml(c.friction) << "\n";
   y << "detection: {tau_min: " << yaml_list(c.tau_threshold);
   if (c.tau_per_speed.size() > 0 && (c.tau_per_speed.array() > 0.0).any())
@@ -215,8 +218,13 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
     const io_detail::Range positive = io_detail::positive();
     const io_detail::Range non_negative = io_detail::non_negative(">= 0 [N]");
     const YAML::Node ob = rd.required(root, "", "observer");
-    rd.only_keys(ob, "observer", {"gain"});
+    rd.only_keys(ob, "observer", {"gain", "residual_cutoff"});
     c.observer_gain = rd.vector(rd.required(ob, "observer", "gain"), "observer.gain", n, &positive);
+    // Absent in files written before the residual filter: none.
+    const io_detail::Range cutoff = io_detail::non_negative(">= 0 [Hz] (0: none)");
+    c.residual_cutoff = ob["residual_cutoff"] ? rd.vector(ob["residual_cutoff"],
+                                                          "observer.residual_cutoff", n, &cutoff)
+                                              : VectorX::Zero(n);
     c.friction =
         io_detail::read_friction_mapping(rd, rd.required(root, "", "friction"), n, "friction");
     const YAML::Node det = rd.required(root, "", "detection");

@@ -57,9 +57,12 @@ void read_contact(const YamlReader& rd, const YAML::Node& c, const Model& model,
 }
 
 void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorOptions& o) {
-  rd.only_keys(ob, "observer", {"gain"});
+  rd.only_keys(ob, "observer", {"gain", "residual_cutoff"});
   const Range gain = positive();
   if (ob["gain"]) o.observer_gain = rd.vector(ob["gain"], "observer.gain", n, &gain);
+  const Range cutoff = io_detail::non_negative(">= 0 [Hz] (0: none)");
+  if (ob["residual_cutoff"])
+    o.residual_cutoff = rd.vector(ob["residual_cutoff"], "observer.residual_cutoff", n, &cutoff);
 }
 
 void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionOptions& o) {
@@ -146,6 +149,20 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
             "'" + path.string() + "' was made with observer.gain " +
                 io_detail::yaml_list(cal.observer_gain) + ", this configuration uses " +
                 io_detail::yaml_list(gains) + ": set the same gain or calibrate again");
+  }
+  // The thresholds hold for the residual filtered as it was at calibration: taken from the file
+  // unless set here, and then it must be the same.
+  const YAML::Node ob = root["observer"];
+  const VectorX cutoff = o.residual_cutoff.size() == 1 ? VectorX::Constant(n, o.residual_cutoff[0])
+                                                       : o.residual_cutoff;
+  if (!(ob && ob["residual_cutoff"])) {
+    o.residual_cutoff = cal.residual_cutoff;
+  } else if (cutoff != cal.residual_cutoff) {
+    rd.fail(node, "calibration",
+            "'" + path.string() + "' was made with observer.residual_cutoff " +
+                io_detail::yaml_list(cal.residual_cutoff) + ", this configuration uses " +
+                io_detail::yaml_list(cutoff) +
+                ": its thresholds are for that filter; set the same cutoff or calibrate again");
   }
   if (cal.sensor_type != o.sensor.type) {
     rd.fail(node, "calibration",
@@ -412,6 +429,8 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
     y << "  point: " << list3(o.contact.point_L) << '\n';
   }
   y << "observer:\n  gain: " << io_detail::yaml_list(o.observer_gain) << '\n';
+  if ((o.residual_cutoff.array() > 0.0).any())
+    y << "  residual_cutoff: " << io_detail::yaml_list(o.residual_cutoff) << '\n';
   y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min);
   if ((o.detection.tau_per_speed.array() > 0.0).any())
     y << "\n  tau_per_speed: " << io_detail::yaml_list(o.detection.tau_per_speed);

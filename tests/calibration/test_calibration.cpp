@@ -325,5 +325,84 @@ TEST(CalibrationFile, SpeedThresholdsRoundTripAndOldFilesStillLoad) {
   }
 }
 
+// The residual filter (observer.residual_cutoff) through calibration: the thresholds and noise
+// are those of the filtered residual, exactly the one the estimator's detector sees; CALIB.yaml
+// carries the cutoff to the configuration that includes it; another cutoff there is refused; a
+// negative one is named.
+TEST(CalibrationFile, TheResidualFilterIsCalibratedAndCarriedWithItsThresholds) {
+  const Model model = paper_arm();
+  EstimatorOptions options = no_sensor();
+  options.residual_cutoff = VectorX{{15, 15, 15, 15, 0, 0, 0}};
+  // Torque noise on every sample: what the filter removes.
+  const auto log = test::simulate_free_motion(
+      model, test::free_motion(0.0, 1.0), test::paper_arm_friction(), 8.0, Vector6::Zero(), 0.2, 5);
+  const Calibration plain = calibrate(model, no_sensor(), log);
+  Calibration cal = calibrate(model, options, log);
+  EXPECT_EQ(cal.residual_cutoff, options.residual_cutoff);
+  // The estimator with the calibration applied: its residual's RMS over the samples used is the
+  // report's (the fit's residual through the same filter).
+  ContactEstimator est(model, GeometryModel{}, apply_calibration(options, cal));
+  ASSERT_TRUE(est.reset(log.front()).ok());
+  VectorX sum2 = VectorX::Zero(7);
+  int count = 0;
+  for (std::size_t k = 1; k < log.size(); ++k) {
+    ASSERT_TRUE(est.update(log[k]).ok());
+    if (log[k].t - log.front().t < 5.0 / 50.0 - 1e-9) continue;
+    sum2 += est.result().residual.cwiseAbs2();
+    ++count;
+  }
+  ASSERT_EQ(count, cal.samples_used);
+  for (int i = 0; i < 7; ++i) {
+    const auto j = static_cast<std::size_t>(i);
+    EXPECT_NEAR(std::sqrt(sum2[i] / count), cal.joints[j].rms_after, 1e-9) << "joint " << i + 1;
+    if (i < 4) {
+      EXPECT_LT(cal.joints[j].noise_std, 0.8 * plain.joints[j].noise_std) << "joint " << i + 1;
+    } else {
+      EXPECT_EQ(cal.joints[j].noise_std, plain.joints[j].noise_std) << "joint " << i + 1;
+    }
+  }
+  cal.source = "free.csv";
+  const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_filter";
+  fs::create_directories(dir);
+  std::ofstream(dir / "calib.yaml") << calibration_to_yaml(cal, nullptr);
+  const std::string robot = (fs::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf").string();
+  const std::string head = "robot: " + robot + "\nsensor: {type: none}\n";
+  const EstimatorConfig cfg = load_estimator_config_string(
+      head + "observer: {gain: 50}\ncalibration: calib.yaml\n", dir / "config.yaml");
+  EXPECT_EQ(cfg.options.residual_cutoff, options.residual_cutoff);
+  const EstimatorConfig same = load_estimator_config_string(
+      head +
+          "observer: {gain: 50, residual_cutoff: [15, 15, 15, 15, 0, 0, 0]}\ncalibration: "
+          "calib.yaml\n",
+      dir / "config.yaml");
+  EXPECT_EQ(same.options.residual_cutoff, options.residual_cutoff);
+  try {
+    (void)load_estimator_config_string(
+        head + "observer: {gain: 50, residual_cutoff: 30}\ncalibration: calib.yaml\n",
+        dir / "config.yaml");
+    FAIL() << "another cutoff than the calibration's was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("config.yaml:4: calibration"), std::string::npos) << what;
+    EXPECT_NE(what.find("residual_cutoff [15, 15, 15, 15, 0, 0, 0]"), std::string::npos) << what;
+  }
+  try {
+    (void)load_estimator_config_string(head + "observer: {gain: 50, residual_cutoff: -1}\n",
+                                       dir / "config.yaml");
+    FAIL() << "a negative cutoff was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("config.yaml:3"), std::string::npos) << what;
+    EXPECT_NE(what.find("observer.residual_cutoff"), std::string::npos) << what;
+  }
+  // Without the key, as before the filter existed: none.
+  const EstimatorConfig none =
+      load_estimator_config_string(head + "observer: {gain: 50}\n", dir / "config.yaml");
+  EXPECT_EQ(none.options.residual_cutoff, VectorX::Zero(1));
+  // Written back, the configuration keeps the cutoff.
+  const EstimatorConfig again = load_estimator_config_string(to_yaml(cfg, dir), dir / "w.yaml");
+  EXPECT_EQ(again.options.residual_cutoff, options.residual_cutoff);
+}
+
 }  // namespace
 }  // namespace extwrench

@@ -9,6 +9,7 @@
 #include "extwrench/calibration/holdout.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
+#include "extwrench/geometry/ray.hpp"
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/log.hpp"
 
@@ -23,10 +24,14 @@ fs::path panda_dir() {
 
 constexpr double kFitFraction = 0.6;
 constexpr double kMaxFalseAlarmShare = 0.001;  // acceptance 2: ≤ 0.1 % of the held-out samples
+constexpr double kClearMargin = 1.5;  // a push's torque this far over a threshold: detectable
+// The residual filter on the proximal joints, whose residual is mostly q̇ noise through K B(q)
+// (docs/calibration.md#residual-filter); the wrist's is friction, which the filter cannot help.
+constexpr const char* kFilteredObserver = "{gain: 50, residual_cutoff: [20, 20, 20, 20, 0, 0, 0]}";
 
-EstimatorConfig panda_config() {
+EstimatorConfig panda_config(const std::string& observer = "{gain: 50}") {
   return load_estimator_config_string("robot: " + (panda_dir() / "panda.urdf").string() +
-                                          "\nsensor: {type: none}\nobserver: {gain: 50}\n",
+                                          "\nsensor: {type: none}\nobserver: " + observer + "\n",
                                       panda_dir() / "config.yaml");
 }
 
@@ -103,6 +108,50 @@ TEST(CalibrationPanda, SpeedThresholdsAgainstConstantOnes) {
   EXPECT_LE(rep.false_alarms, kMaxFalseAlarmShare * rep.samples);
 }
 
+// The residual filter (observer.residual_cutoff) on joints 1-4: their calibrated thresholds fall
+// to at most 60 % of the unfiltered ones, the held-out motion stays quiet, the wrist's
+// (unfiltered) thresholds do not move, and the model check had named those four joints.
+TEST(CalibrationPanda, TheResidualFilterLowersTheProximalThresholds) {
+  if (!fs::exists(panda_dir() / "log.csv")) GTEST_SKIP() << "no " << panda_dir();
+  const EstimatorConfig plain = panda_config();
+  const EstimatorConfig filtered = panda_config(kFilteredObserver);
+  const Model& model = plain.robot.model;
+  const std::vector<Sample> samples = panda_log(model);
+  const auto first = static_cast<std::size_t>(kFitFraction * static_cast<double>(samples.size()));
+  const std::vector<Sample> fit(samples.begin(), samples.begin() + static_cast<long>(first));
+  const Calibration before = calibrate(model, plain.options, fit);
+  const Calibration after = calibrate(model, filtered.options, fit);
+  const HoldoutReport rep = validate_holdout(model, filtered.options, after, samples, first);
+  EXPECT_LE(rep.false_alarms, kMaxFalseAlarmShare * rep.samples);
+  for (int i = 0; i < 7; ++i) {
+    const auto j = static_cast<std::size_t>(i);
+    std::printf("joint %d: threshold %.3f + %.3f|dq| -> %.3f + %.3f|dq| N m, noise %.3f -> %.3f\n",
+                i + 1, before.tau_threshold[i], before.tau_per_speed[i], after.tau_threshold[i],
+                after.tau_per_speed[i], before.joints[j].noise_std, after.joints[j].noise_std);
+    const double mean_before = before.joints[j].speed_dependent
+                                   ? before.joints[j].mean_threshold_speed
+                                   : before.tau_threshold[i];
+    const double mean_after = after.joints[j].speed_dependent ? after.joints[j].mean_threshold_speed
+                                                              : after.tau_threshold[i];
+    if (i < 4) {
+      EXPECT_LT(mean_after, 0.6 * mean_before) << "joint " << i + 1;
+      EXPECT_LT(after.joints[j].noise_std, 0.7 * before.joints[j].noise_std) << "joint " << i + 1;
+    } else {
+      EXPECT_EQ(after.tau_threshold[i], before.tau_threshold[i]) << "joint " << i + 1;
+    }
+  }
+  EXPECT_EQ(after.residual_cutoff, filtered.options.residual_cutoff);
+  // The model check names what the filter removes, on joints 1-4 only, and not once filtered.
+  const auto high_frequency_joints = [](const Calibration& c) {
+    std::vector<int> joints;
+    for (const ModelPattern& p : c.model_check.patterns)
+      if (p.kind == "high_frequency") joints.push_back(p.joint);
+    return joints;
+  };
+  EXPECT_EQ(high_frequency_joints(before), (std::vector<int>{1, 2, 3, 4}));
+  EXPECT_TRUE(high_frequency_joints(after).empty());
+}
+
 // A 15 N push superposed on the real torques (τ − J_lᵀ F) from 80 % of the log on: a point
 // 0.1 m from link l's origin, perpendicular to its joint axis, the force tangential (fixed in
 // the link frame). Detected within 50 ms, on link l, for the wrist links whose thresholds the
@@ -159,6 +208,139 @@ TEST(CalibrationPanda, PushSuperposedOnTheRealTorquesIsDetectedOnTheWrist) {
       EXPECT_EQ(isolated_at_window, link);
     }
   }
+}
+
+// Acceptance 2's pushes at surface points: on each of links 3-7, a pusher comes along each axis
+// of the link frame (±x, ±y, ±z) aimed at the centre of the link's collision shapes; where it
+// first meets the arm on that link (no other link in the way), a 15 N force along its direction
+// acts from 80 % of the log on (fixed in the link frame), superposed on the real torques as
+// τ − J_vᵀ F. K = 50 with the residual filter on joints 1-4. Every push whose torque is clearly
+// over a threshold is detected within 50 ms, and every push whose link is observable is on that
+// link at 50 ms. Without the filter 13 of the 19 are detected in time (17 with it).
+struct SurfacePush {
+  int link = 0;
+  Vector3 point_L, force_L;
+};
+
+std::vector<SurfacePush> surface_pushes(const Model& model, const GeometryModel& geometry,
+                                        const VectorX& q) {
+  Data data(model);
+  forward_kinematics(model, data, q);
+  std::vector<SurfacePush> pushes;
+  for (int link = 3; link <= 7; ++link) {
+    const auto l = static_cast<std::size_t>(link);
+    Vector3 lo = Vector3::Constant(1e9), hi = Vector3::Constant(-1e9);
+    for (int s : geometry.body_shapes[l]) {
+      const CollisionShape& shape = geometry.shapes[static_cast<std::size_t>(s)];
+      if (shape.type != ShapeType::kMesh) continue;
+      for (Eigen::Index v = 0; v < shape.mesh->vertices.cols(); ++v) {
+        const Vector3 p = shape.placement.act(shape.mesh->vertices.col(v));
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+    }
+    if (!(lo.array() <= hi.array()).all()) continue;
+    const Pose& X_WL = data.X_WB[l];
+    const Vector3 centre_W = X_WL.act(0.5 * (lo + hi));
+    for (int axis = 0; axis < 6; ++axis) {
+      const Vector3 d_L = (axis % 2 == 0 ? 1.0 : -1.0) * Vector3::Unit(axis / 2);
+      const Vector3 d_W = X_WL.rotation * d_L;
+      const Vector3 start_W = centre_W - 2.0 * d_W;
+      const SurfacePointResult on_link =
+          intersect_line_with_body(geometry, link, X_WL, start_W, d_W, OnMiss::kNothing);
+      if (!on_link.hit) continue;
+      bool blocked = false;
+      for (int b = 0; b < model.num_bodies() && !blocked; ++b) {
+        if (b == link) continue;
+        const SurfacePointResult other = intersect_line_with_body(
+            geometry, b, data.X_WB[static_cast<std::size_t>(b)], start_W, d_W, OnMiss::kNothing);
+        blocked = other.hit && other.entry.lambda < on_link.entry.lambda;
+      }
+      if (blocked) continue;
+      pushes.push_back({link, X_WL.inverse().act(on_link.entry.point_W), 15.0 * d_L});
+    }
+  }
+  return pushes;
+}
+
+TEST(CalibrationPanda, PushesAtSurfacePointsAreDetectedWithin50ms) {
+  if (!fs::exists(panda_dir() / "log.csv")) GTEST_SKIP() << "no " << panda_dir();
+  const EstimatorConfig cfg = panda_config(kFilteredObserver);
+  const Model& model = cfg.robot.model;
+  const std::vector<Sample> free = panda_log(model);
+  const auto first = static_cast<std::size_t>(kFitFraction * static_cast<double>(free.size()));
+  const Calibration cal =
+      calibrate(model, cfg.options,
+                std::vector<Sample>(free.begin(), free.begin() + static_cast<long>(first)));
+  const std::size_t start = free.size() * 8 / 10;
+  const std::vector<SurfacePush> pushes = surface_pushes(model, cfg.robot.geometry, free[start].q);
+  Data data(model);
+  Matrix6X J = Matrix6X::Zero(6, model.nq());
+  const EstimatorOptions options = apply_calibration(cfg.options, cal);
+  int detected = 0, right = 0, detectable_count = 0, observable_count = 0;
+  for (const SurfacePush& push : pushes) {
+    std::vector<Sample> pushed = free;
+    const auto l = static_cast<std::size_t>(push.link);
+    for (std::size_t k = start; k < pushed.size(); ++k) {
+      forward_kinematics(model, data, pushed[k].q);
+      const Pose& X_WL = data.X_WB[l];
+      point_jacobian(model, data, push.link, X_WL.act(push.point_L), J);
+      pushed[k].tau -= J.topRows<3>().transpose() * (X_WL.rotation * push.force_L);
+    }
+    ContactEstimator est(model, cfg.robot.geometry, options);
+    ASSERT_TRUE(est.reset(pushed.front()).ok());
+    double delay = -1.0, over = 0.0, own = 0.0;
+    int at_window = -1;
+    bool early = false;
+    for (std::size_t k = 1; k < pushed.size(); ++k) {
+      ASSERT_TRUE(est.update(pushed[k]).ok());
+      if (k >= first && k < start && est.result().contact) early = true;
+      if (k >= start && delay < 0 && est.result().contact) delay = pushed[k].t - pushed[start].t;
+      if (k >= start && at_window < 0 && pushed[k].t - pushed[start].t >= 0.05) {
+        at_window = est.result().link;
+        // What the residual can see of this push: its torque over each joint's threshold.
+        forward_kinematics(model, data, pushed[k].q);
+        point_jacobian(model, data, push.link, data.X_WB[l].act(push.point_L), J);
+        const VectorX tau_push =
+            J.topRows<3>().transpose() * (data.X_WB[l].rotation * push.force_L);
+        const VectorX ratio = tau_push.cwiseAbs().cwiseQuotient(est.detector().thresholds());
+        over = ratio.maxCoeff();
+        own = ratio[push.link - 1];
+      }
+    }
+    EXPECT_FALSE(early) << "a false alarm on the held-out free motion before the push";
+    // Detectable: the push's torque is clearly over some joint's threshold (after 50 ms the
+    // residual, K = 50 and the filter, has reached ~85 % of it). The link is observable when
+    // the paper's rule can name it (its own joint clearly over) or, without a sensor, when the
+    // geometry test has a line to test (links 6-7: a pure force's line takes 5 joints, a test
+    // of it one more; Table I case E).
+    const bool detectable = over >= kClearMargin;
+    const bool observable = detectable && (own >= kClearMargin || push.link >= 6);
+    const bool in_time = delay >= 0 && delay <= 0.05 + 1e-9;
+    detected += in_time ? 1 : 0;
+    right += in_time && at_window == push.link ? 1 : 0;
+    detectable_count += detectable ? 1 : 0;
+    observable_count += observable ? 1 : 0;
+    if (detectable) {
+      EXPECT_TRUE(in_time) << "link " << push.link << ", delay " << delay;
+    }
+    if (observable) {
+      EXPECT_EQ(at_window, push.link);
+    }
+    std::printf(
+        "link %d, point_L (%+.3f %+.3f %+.3f), force_L (%+.0f %+.0f %+.0f) N: torque / threshold "
+        "%.2f (own joint %.2f); delay %.3f s, link at 50 ms %d\n",
+        push.link, push.point_L.x(), push.point_L.y(), push.point_L.z(), push.force_L.x(),
+        push.force_L.y(), push.force_L.z(), over, own, delay, at_window);
+  }
+  std::printf(
+      "%d pushes at surface points: %d detected within 50 ms (%d clearly over a threshold), %d "
+      "on the right link at 50 ms (%d observable)\n",
+      static_cast<int>(pushes.size()), detected, detectable_count, right, observable_count);
+  RecordProperty("surface_pushes", std::to_string(pushes.size()) + " pushes, " +
+                                       std::to_string(detected) + " detected within 50 ms, " +
+                                       std::to_string(right) + " on the right link");
+  EXPECT_GE(pushes.size(), 15u);
 }
 
 }  // namespace

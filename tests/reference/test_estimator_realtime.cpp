@@ -52,6 +52,7 @@ struct Config {
   SensorType sensor;
   ContactModel contact;
   AccelerationRoute route;
+  double residual_cutoff = 0.0;  ///< [Hz] the residual filter (0: none)
 };
 
 std::vector<Config> all_configs() {
@@ -63,6 +64,8 @@ std::vector<Config> all_configs() {
         out.push_back({s, c, r});
       }
     }
+    // The residual filter's state too (observer.residual_cutoff).
+    out.push_back({s, ContactModel::kPureForce, AccelerationRoute::kResidual, 80.0});
   }
   return out;
 }
@@ -78,12 +81,14 @@ EstimatorOptions options_for(const Config& c) {
   o.detection.min_duration = 0.0;
   o.detection.tau_min = VectorX::Constant(1, 0.05);
   o.sensor.tare_samples = 5;
+  o.residual_cutoff = VectorX::Constant(1, c.residual_cutoff);
   return o;
 }
 
 std::string describe(const Config& c) {
   return std::string(to_string(c.sensor)) + "/" + std::string(to_string(c.contact)) + "/" +
-         std::string(to_string(c.route));
+         std::string(to_string(c.route)) +
+         (c.residual_cutoff > 0 ? "/residual_cutoff " + std::to_string(c.residual_cutoff) : "");
 }
 
 TEST(EstimatorRealTime, TenThousandUpdatesOfEveryConfigurationAllocateNothing) {

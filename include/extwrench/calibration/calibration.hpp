@@ -88,7 +88,7 @@ struct JointFitReport {
 
 /// A recognisable error of the model named by the model check (docs/calibration.md#model-check).
 struct ModelPattern {
-  std::string kind;    ///< base_force_offset | gravity | coulomb | sensor_pose
+  std::string kind;    ///< base_force_offset | gravity | coulomb | sensor_pose | high_frequency
   int joint = 0;       ///< 1-based joint, 0 for the base sensor
   double share = 0.0;  ///< R² of the pattern's regression, or offset / spread
   std::string message;
@@ -114,6 +114,9 @@ struct Calibration {
   VectorX tau_threshold;   ///< detection τ_min per joint (n) [N m]: a of τ_thr = a + b|q̇|
   VectorX tau_per_speed;   ///< b per joint (n) [N m s/rad]; empty or zero: constant thresholds
   VectorX observer_gain;   ///< K the residual and thresholds were computed with (n)
+  /// The residual filter's cutoff per joint they were computed with (n) [Hz] (0: none;
+  /// residual_filter.hpp).
+  VectorX residual_cutoff;
   SensorType sensor_type = SensorType::kNone;
   Vector6 sensor_bias_S = Vector6::Zero();  ///< [f; n] in S (moment zero for a force sensor)
   Vector3 force_noise_W = Vector3::Zero();  ///< std of F̂_ext per world axis after the bias [N]
@@ -150,7 +153,8 @@ struct Calibration {
 [[nodiscard]] bool add_identified_payload(const Calibration& calibration,
                                           EstimatorOptions& options);
 
-/// The options with the calibration applied: friction, detection.tau_min and tau_per_speed,
+/// The options with the calibration applied: friction, residual_cutoff, detection.tau_min and
+/// tau_per_speed,
 /// (with a sensor) f_min and the sensor bias, and an identified payload (added to a configured
 /// one on the same body; throws extwrench::Error when the configured one is on another body).
 [[nodiscard]] EstimatorOptions apply_calibration(EstimatorOptions options,

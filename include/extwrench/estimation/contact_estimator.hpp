@@ -32,6 +32,7 @@
 #include "extwrench/estimation/wrench_cases.hpp"
 #include "extwrench/geometry/shapes.hpp"
 #include "extwrench/observer/momentum_observer.hpp"
+#include "extwrench/observer/residual_filter.hpp"
 
 namespace extwrench {
 
@@ -67,6 +68,8 @@ class ContactEstimator {
 
   /// Expert entry: q̈̂ and τ̂_ext supplied by the caller (another observer, or exact values in
   /// tests); runs tare, detection, isolation and Table I, but not the observer. t must increase.
+  /// With options.residual_cutoff > 0 the supplied τ̂_ext goes through the same low-pass as the
+  /// observer's residual would (started at rest on the first value).
   [[nodiscard]] Status update_with(double t, const Eigen::Ref<const VectorX>& q,
                                    const Eigen::Ref<const VectorX>& dq,
                                    const Eigen::Ref<const VectorX>& ddq,
@@ -144,6 +147,7 @@ class ContactEstimator {
   Data data_;
   GeometryModel geometry_;
   MomentumObserver observer_;
+  ResidualFilter residual_filter_;  ///< options_.residual_cutoff on τ̂_ext (off at 0)
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
   IsolationWorkspace isolation_ws_;

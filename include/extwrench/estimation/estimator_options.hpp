@@ -53,7 +53,11 @@ struct EstimatorOptions {
   DetectionOptions detection;
   IsolationOptions isolation;  ///< which rule picks the contact link (isolation.hpp)
   AccelerationRoute acceleration = AccelerationRoute::kResidual;
-  double differentiation_cutoff = 50.0;   ///< [Hz] low-pass of the differentiated q̇ (route (a))
+  double differentiation_cutoff = 50.0;  ///< [Hz] low-pass of the differentiated q̇ (route (a))
+  /// [Hz] ≥ 0, size 1 or n: second-order low-pass of τ̂_ext before stages 5–9 per joint
+  /// (residual_filter.hpp); 0: none. For real arms whose q̇ noise reaches r through K B(q) δq̇
+  /// (docs/estimator.md#residual-filter).
+  VectorX residual_cutoff = VectorX::Zero(1);
   std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction
   std::optional<PayloadOptions> payload;
   SolverOptions solver;
