@@ -343,23 +343,9 @@ void exclude_windows(const std::vector<SuspectWindow>& windows, const std::vecto
       if (samples[k].t >= w.t_begin - kWindowGap && samples[k].t <= w.t_end + settle) use[k] = 0;
 }
 
-/// The residual filter (residual_filter.hpp) over a joint's residual series, from rest at 0 as
-/// the estimator's after a reset at the first sample: the same steps, so the same bits.
-std::vector<double> filtered_residual(std::vector<double> r, const std::vector<Sample>& samples,
-                                      double cutoff) {
-  if (!(cutoff > 0.0)) return r;
-  double s1 = 0.0, s2 = 0.0;
-  for (std::size_t k = 1; k < r.size(); ++k) {
-    const double w = residual_filter_weight(cutoff, samples[k].t - samples[k - 1].t);
-    r[k] = residual_filter_step(w, r[k], s1, s2);
-  }
-  return r;
-}
-
 /// The fitted friction and offsets into `cal`, and per joint the residual's threshold for the
-/// false-alarm rate, before (r0, the model's own friction) and after the fit. The thresholds,
-/// noise and RMS are those of the residual as the detector sees it (through the residual filter
-/// at cal.residual_cutoff); the fit itself is on the observer's residual.
+/// false-alarm rate, before (r0, the model's own friction) and after the fit: of the residual as
+/// the detector sees it (through the residual filter, where one is configured).
 void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
                              const std::vector<JointSeries>& series,
                              const std::vector<JointSeries>& before,
@@ -386,18 +372,14 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
     JointFitReport j;
     j.condition = f.condition;
     JointFitReport b;
-    joint_threshold(
-        filtered_residual(before[static_cast<std::size_t>(i)].r0, samples, cal.residual_cutoff[i]),
-        samples, use, rate, 1.0, b);
+    joint_threshold(before[static_cast<std::size_t>(i)].r0, samples, use, rate, 1.0, b);
     j.rms_before = b.rms_after;
     j.max_before = b.max_after;
-    const std::vector<double> residual =
-        filtered_residual(f.residual, samples, cal.residual_cutoff[i]);
-    joint_threshold(residual, samples, use, rate, o.threshold_margin, j);
+    joint_threshold(f.residual, samples, use, rate, o.threshold_margin, j);
     j.variance_explained =
         b.noise_std > 0 ? 1.0 - (j.noise_std * j.noise_std) / (b.noise_std * b.noise_std) : 0.0;
     j.threshold_constant = j.threshold;
-    speed_threshold(residual, series[static_cast<std::size_t>(i)].dq, samples, use, rate,
+    speed_threshold(f.residual, series[static_cast<std::size_t>(i)].dq, samples, use, rate,
                     o.threshold_margin, j);
     j.speed_dependent = j.threshold_per_speed > 0.0 &&
                         (o.thresholds == ThresholdModel::kSpeed ||
@@ -446,19 +428,20 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   }
   Calibration cal;
   if (o.payload) {
-    if (options.sensor.type != SensorType::kForceTorque) {
+    if (options.sensor.type == SensorType::kNone) {
       throw Error(
-          "calibration: payload identification needs a base force/torque sensor (sensor.type: "
-          "ft; the moments carry the centre of mass), this configuration has sensor.type: " +
-          std::string(to_string(options.sensor.type)));
+          "calibration: payload identification needs a base force/torque sensor or force sensor "
+          "(sensor.type: ft | force; its force separates the payload's weight from the joints' "
+          "offsets), this configuration has sensor.type: none");
     }
     if (options.payload && options.payload->body != n) {
       throw Error("calibration: the configuration has a payload on body " +
                   std::to_string(options.payload->body) +
                   "; payload identification is for the last link (" + std::to_string(n) + ")");
     }
-    const calibration_detail::PayloadFit pf =
-        calibration_detail::fit_payload(m, options.sensor.X_WS, n, samples, use);
+    const calibration_detail::PayloadFit pf = calibration_detail::fit_payload(
+        m, options.sensor.X_WS, n, options.sensor.type == SensorType::kForceTorque,
+        o.smoothing_velocity > 0 ? o.smoothing_velocity : 0.01, samples, use);
     cal.payload.identified = true;
     cal.payload.body = n;
     cal.payload.mass = pf.mass;
@@ -486,6 +469,20 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   cal.residual_cutoff = options.residual_cutoff.size() == 1
                             ? VectorX::Constant(n, options.residual_cutoff[0])
                             : options.residual_cutoff;
+  // The residual filter: every series from here on is the filtered residual (r is linear in θ,
+  // so filtering r⁰ and each regressor gives the estimator's filtered residual, to rounding).
+  for (int i = 0; i < n; ++i) {
+    const double cutoff = cal.residual_cutoff[i];
+    if (!(cutoff > 0.0)) continue;
+    std::vector<double> weight(samples.size(), 0.0);
+    for (std::size_t k = 1; k < samples.size(); ++k)
+      weight[k] = residual_filter_weight(cutoff, samples[k].t - samples[k - 1].t);
+    for (std::vector<JointSeries>* s : {&series, &before}) {
+      JointSeries& js = (*s)[static_cast<std::size_t>(i)];
+      calibration_detail::apply_residual_filter(weight, js.r0);
+      js.filter_weight = weight;
+    }
+  }
   cal.sensor_type = options.sensor.type;
   cal.false_alarms_per_hour = o.false_alarms_per_hour;
   cal.t_begin = samples.front().t;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/observer/residual_filter.hpp"
 
 namespace extwrench::calibration_detail {
 namespace {
@@ -91,10 +92,17 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
 }
 
 void filter_regressor(const std::vector<double>& phi, const std::vector<double>& alpha,
-                      std::vector<double>& z) {
+                      std::vector<double>& z, const std::vector<double>& residual_filter_weight) {
   z.assign(phi.size(), 0.0);
   for (std::size_t k = 1; k < phi.size(); ++k)
     z[k] = alpha[k] * z[k - 1] + (1.0 - alpha[k]) * 0.5 * (phi[k - 1] + phi[k]);
+  apply_residual_filter(residual_filter_weight, z);
+}
+
+void apply_residual_filter(const std::vector<double>& weight, std::vector<double>& x) {
+  if (weight.empty()) return;
+  double s1 = 0.0, s2 = 0.0;
+  for (std::size_t k = 1; k < x.size(); ++k) x[k] = residual_filter_step(weight[k], x[k], s1, s2);
 }
 
 void check_excitation(const JointSeries& s, const std::vector<char>& use, int joint,
@@ -129,8 +137,8 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                            const CalibrationOptions& options, int joint) {
   const std::size_t N = s.dq.size();
   std::vector<double> ones(N, 1.0), z_viscous, z_offset, phi(N), z_coulomb;
-  filter_regressor(s.dq, s.alpha, z_viscous);
-  filter_regressor(ones, s.alpha, z_offset);
+  filter_regressor(s.dq, s.alpha, z_viscous, s.filter_weight);
+  filter_regressor(ones, s.alpha, z_offset, s.filter_weight);
   std::vector<double> smoothings(kSmoothingGrid.begin(), kSmoothingGrid.end());
   if (options.smoothing_velocity > 0) smoothings = {options.smoothing_velocity};
   std::vector<double> shifts{0.0};
@@ -141,7 +149,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   for (const double vs : smoothings) {
     for (const double shift : shifts) {
       for (std::size_t k = 0; k < N; ++k) phi[k] = smooth_sign(options.sign, s.dq[k], vs, shift);
-      filter_regressor(phi, s.alpha, z_coulomb);
+      filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
       std::array<bool, 3> active{true, true, true};
       Solve sol =
           solve({&z_viscous, &z_coulomb, &z_offset}, s.r0, use, active, options.regularisation);
@@ -173,7 +181,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   // The residual with the chosen friction, over the whole log.
   for (std::size_t k = 0; k < N; ++k)
     phi[k] = smooth_sign(options.sign, s.dq[k], best.smoothing, best.shift);
-  filter_regressor(phi, s.alpha, z_coulomb);
+  filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
   best.residual.resize(N);
   for (std::size_t k = 0; k < N; ++k)
     best.residual[k] = s.r0[k] + best.viscous * z_viscous[k] + best.coulomb * z_coulomb[k] +

@@ -10,9 +10,11 @@
 namespace extwrench::calibration_detail {
 
 /// One joint's series over the log: q̇_k, the residual r⁰_k without friction, and the filter
-/// coefficient α_k = e^{−K Δt_k} of the step ending at sample k (α_0 unused).
+/// coefficient α_k = e^{−K Δt_k} of the step ending at sample k (α_0 unused). With a residual
+/// filter on the joint (observer.residual_cutoff), its weight per step (residual_filter.hpp;
+/// empty: none), and r⁰ is then the filtered residual: the fit minimises what the detector sees.
 struct JointSeries {
-  std::vector<double> dq, r0, alpha;
+  std::vector<double> dq, r0, alpha, filter_weight;
 };
 
 /// The fitted friction of one joint and its fit statistics.
@@ -33,9 +35,15 @@ struct LineFit {
 [[nodiscard]] LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
                                const std::vector<char>& use);
 
-/// The observer's filter of a regressor: z_k = α_k z_{k−1} + (1 − α_k) ½ (φ_{k−1} + φ_k), z_0 = 0.
+/// The observer's filter of a regressor: z_k = α_k z_{k−1} + (1 − α_k) ½ (φ_{k−1} + φ_k), z_0 = 0;
+/// then, when `residual_filter_weight` is not empty, the residual filter's two sections with
+/// those weights per step (from rest at 0, as the estimator's after a reset).
 void filter_regressor(const std::vector<double>& phi, const std::vector<double>& alpha,
-                      std::vector<double>& z);
+                      std::vector<double>& z,
+                      const std::vector<double>& residual_filter_weight = {});
+
+/// The residual filter over a series in place, with its weights per step (none when empty).
+void apply_residual_filter(const std::vector<double>& weight, std::vector<double>& x);
 
 /// Throws extwrench::Error when joint `joint` (1-based) does not move enough, in both
 /// directions, to identify its viscous and Coulomb friction over the samples in `use`.

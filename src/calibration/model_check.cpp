@@ -73,7 +73,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     phi.assign(s.dq.size(), 0.0);
     for (std::size_t k = 0; k < s.dq.size(); ++k)
       phi[k] = s.dq[k] > 0 ? 1.0 : (s.dq[k] < 0 ? -1.0 : 0.0);
-    filter_regressor(phi, s.alpha, z);
+    filter_regressor(phi, s.alpha, z, s.filter_weight);
     const LineFit coulomb = fit_line(z, before[i].r0, use);
     if (coulomb.r2 >= kJointShare) {
       check.patterns.push_back({"coulomb", joint, coulomb.r2,
@@ -83,14 +83,14 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
                                     "): Coulomb friction the model lacks (calibrated)"});
     }
     // Follows g(q): the calibrated residual against the filtered gravity torque.
-    filter_regressor(gravity[i], s.alpha, z);
+    filter_regressor(gravity[i], s.alpha, z, s.filter_weight);
     const LineFit g = fit_line(z, after[i].residual, use);
     if (g.r2 >= kJointShare) {
       check.patterns.push_back(
           {"gravity", joint, g.r2,
            "joint " + std::to_string(joint) + ": the calibrated residual follows g(q) (" +
                num(100.0 * g.slope) + " % of it, R^2 " + num(g.r2) +
-               "): a gravity / mass error in the model (a payload? --payload with a F/T sensor)"});
+               "): a gravity / mass error in the model (a payload? --payload, with a base sensor)"});
     }
     // Mostly above ~20 Hz (unfiltered joints only): the velocity's noise through K B(q), or the
     // torque's, which the residual filter removes (docs/estimator.md#residual-filter).

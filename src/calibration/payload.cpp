@@ -1,7 +1,9 @@
-// Payload identification from the base wrench (docs/calibration.md#payload): the reading of a
-// base F/T sensor is linear in the payload's mass m and first moment h = m c (c its CoM in the
-// last link's frame) once its rotational inertia about the link origin is neglected, and the
-// sensor bias adds a constant; so [m, h, bias] is one linear least-squares problem over the log.
+// Payload identification from the base wrench and the joint torques together
+// (docs/calibration.md#payload): the reading of a base sensor and the joint torques are linear
+// in the payload's mass m and first moment h = m c (c its CoM in the last link's frame) once its
+// rotational inertia about the link origin is neglected; the sensor bias adds a constant, the
+// joints' friction and offsets their own terms; so [m, h, bias, friction] is one linear
+// least-squares problem over the log.
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
@@ -30,8 +32,9 @@ Inertia unit_first_moment(const Vector3& h) {
 
 }  // namespace
 
-PayloadFit fit_payload(const Model& model, const Pose& X_WS, int body,
-                       const std::vector<Sample>& samples, const std::vector<char>& use) {
+PayloadFit fit_payload(const Model& model, const Pose& X_WS, int body, bool moments,
+                       double smoothing_velocity, const std::vector<Sample>& samples,
+                       const std::vector<char>& use) {
   const int n = model.nq();
   if (body < 1 || body > n) throw Error("payload: body " + std::to_string(body) + " out of range");
   // Five models: as given, + unit mass at the origin, + unit first moment along x, y, z.
@@ -48,15 +51,19 @@ PayloadFit fit_payload(const Model& model, const Pose& X_WS, int body,
   std::vector<Data> data;
   data.reserve(5);
   for (const Model& m : models) data.emplace_back(m);
-  constexpr int kParams = 10;  // m, h (3), bias [f; n] (6)
-  Eigen::Matrix<double, kParams, kParams> AtA = Eigen::Matrix<double, kParams, kParams>::Zero();
-  Eigen::Matrix<double, kParams, 1> Aty = Eigen::Matrix<double, kParams, 1>::Zero();
-  double yy = 0.0;
+  // Unknowns: m, h (3), the bias (6 or 3), and per joint viscous, Coulomb, offset.
+  const int axes = moments ? 6 : 3;
+  const int first_friction = 4 + axes;
+  const int params = first_friction + 3 * n;
+  // One row group per sensor axis and per joint: its normal equations, Σy and Σy², so that
+  // each group's misfit for any θ comes from sums alone (no rows are kept).
+  const int groups = axes + n;
+  std::vector<MatrixX> AtA(static_cast<std::size_t>(groups), MatrixX::Zero(params, params));
+  std::vector<VectorX> Aty(static_cast<std::size_t>(groups), VectorX::Zero(params));
+  std::vector<double> yy(static_cast<std::size_t>(groups), 0.0);
+  std::vector<double> ysum(static_cast<std::size_t>(groups), 0.0);
   std::size_t rows = 0;
-  VectorX ddq(n);
-  Eigen::Matrix<double, 6, kParams> A;
-  std::vector<Vector6> y_all;
-  std::vector<Eigen::Matrix<double, 6, kParams>> a_all;
+  VectorX ddq(n), row(params);
   const std::size_t N = samples.size();
   for (std::size_t k = kHalfWidth; k + kHalfWidth < N; ++k) {
     if (!use[k]) continue;
@@ -69,46 +76,88 @@ PayloadFit fit_payload(const Model& model, const Pose& X_WS, int body,
       (void)rnea(models[j], data[j], s.q, s.dq, ddq);
       r[j] = sensor_reading(data[j], X_WS);
     }
-    A.col(0) = r[1] - r[0];
-    for (int a = 0; a < 3; ++a) A.col(1 + a) = r[2 + a] - r[1];
-    A.rightCols<6>().setIdentity();
-    const Vector6 y = s.reading_S - r[0];
-    AtA.noalias() += A.transpose() * A;
-    Aty.noalias() += A.transpose() * y;
-    yy += y.squaredNorm();
-    y_all.push_back(y);
-    a_all.push_back(A);
+    const auto add = [&](int g, double y) {
+      const auto gi = static_cast<std::size_t>(g);
+      AtA[gi].selfadjointView<Eigen::Lower>().rankUpdate(row);
+      Aty[gi].noalias() += y * row;
+      yy[gi] += y * y;
+      ysum[gi] += y;
+    };
+    for (int a = 0; a < axes; ++a) {
+      row.setZero();
+      row[0] = r[1][a] - r[0][a];
+      for (int c = 0; c < 3; ++c) row[1 + c] = r[2 + c][a] - r[1][a];
+      row[4 + a] = 1.0;
+      add(a, s.reading_S[a] - r[0][a]);
+    }
+    for (int i = 0; i < n; ++i) {
+      row.setZero();
+      row[0] = data[1].tau[i] - data[0].tau[i];
+      for (int c = 0; c < 3; ++c) row[1 + c] = data[2 + c].tau[i] - data[1].tau[i];
+      row[first_friction + 3 * i] = s.dq[i];
+      row[first_friction + 3 * i + 1] = std::tanh(s.dq[i] / smoothing_velocity);
+      row[first_friction + 3 * i + 2] = 1.0;
+      add(axes + i, s.tau[i] - data[0].tau[i]);
+    }
     ++rows;
   }
-  if (rows < 2 * kParams) {
-    throw Error("payload: " + std::to_string(rows) + " samples for " + std::to_string(kParams) +
+  if (rows < static_cast<std::size_t>(params)) {
+    throw Error("payload: " + std::to_string(rows) + " samples for " + std::to_string(params) +
                 " parameters: record a longer motion");
   }
-  // Column scaling for the condition number.
-  const Eigen::Matrix<double, kParams, 1> scale = AtA.diagonal().cwiseSqrt().cwiseMax(1e-12);
-  const Eigen::Matrix<double, kParams, kParams> S = scale.cwiseInverse().asDiagonal();
-  const Eigen::Matrix<double, kParams, kParams> N_scaled = S * AtA * S;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kParams, kParams>> eig(N_scaled);
+  for (MatrixX& m : AtA) m = m.selfadjointView<Eigen::Lower>();
+  const auto misfit = [&](int g, const VectorX& theta) {  // Σ (y − aᵀθ)² of group g
+    const auto gi = static_cast<std::size_t>(g);
+    return std::max(yy[gi] - 2.0 * theta.dot(Aty[gi]) + theta.dot(AtA[gi] * theta), 0.0);
+  };
+  // Two passes: unit weights, then each group by the inverse of its first-pass misfit's RMS
+  // (sensor axes in N and N m, joints in N m: each measured against its own noise).
+  std::vector<double> weight(static_cast<std::size_t>(groups), 1.0);
   PayloadFit fit;
-  fit.condition =
-      std::sqrt(eig.eigenvalues().maxCoeff() / std::max(eig.eigenvalues().minCoeff(), 1e-300));
-  const Eigen::Matrix<double, kParams, 1> theta = S * N_scaled.ldlt().solve(S * Aty);
+  VectorX theta(params);
+  for (int pass = 0; pass < 2; ++pass) {
+    MatrixX normal = MatrixX::Zero(params, params);
+    VectorX rhs = VectorX::Zero(params);
+    for (int g = 0; g < groups; ++g) {
+      normal += weight[static_cast<std::size_t>(g)] * AtA[static_cast<std::size_t>(g)];
+      rhs += weight[static_cast<std::size_t>(g)] * Aty[static_cast<std::size_t>(g)];
+    }
+    // Column scaling for the condition number.
+    const VectorX scale = normal.diagonal().cwiseSqrt().cwiseMax(1e-12);
+    const MatrixX S = scale.cwiseInverse().asDiagonal();
+    const MatrixX scaled = S * normal * S;
+    Eigen::SelfAdjointEigenSolver<MatrixX> eig(scaled);
+    fit.condition =
+        std::sqrt(eig.eigenvalues().maxCoeff() / std::max(eig.eigenvalues().minCoeff(), 1e-300));
+    theta = S * scaled.ldlt().solve(S * rhs);
+    for (int g = 0; g < groups; ++g) {
+      const double rms = std::sqrt(misfit(g, theta) / static_cast<double>(rows));
+      weight[static_cast<std::size_t>(g)] = 1.0 / std::max(rms * rms, 1e-12);
+    }
+  }
   fit.mass = theta[0];
   fit.first_moment = theta.segment<3>(1);
-  fit.bias_S = theta.tail<6>();
-  // RMS of the sensor's prediction error per axis with only the bias, and with the payload too.
-  Vector6 before = Vector6::Zero(), after = Vector6::Zero();
-  Vector6 mean_y = Vector6::Zero();
-  for (const Vector6& y : y_all) mean_y += y;
-  mean_y /= static_cast<double>(rows);
-  for (std::size_t k = 0; k < rows; ++k) {
-    before += (y_all[k] - mean_y).cwiseAbs2();
-    after += (y_all[k] - a_all[k] * theta).cwiseAbs2();
+  fit.bias_S.head(axes) = theta.segment(4, axes);
+  // RMS per sensor axis and joint with the bias (and friction) only, and with the payload too.
+  VectorX no_payload = theta;
+  no_payload.head<4>().setZero();
+  const auto rms = [&](int g, const VectorX& th) {
+    return std::sqrt(misfit(g, th) / static_cast<double>(rows));
+  };
+  for (int a = 0; a < axes; ++a) {
+    // Before: the spread about the mean (the bias alone absorbs the mean).
+    const auto gi = static_cast<std::size_t>(a);
+    const double mean = ysum[gi] / static_cast<double>(rows);
+    fit.rms_before[a] = std::sqrt(std::max(yy[gi] / static_cast<double>(rows) - mean * mean, 0.0));
+    fit.rms_after[a] = rms(a, theta);
   }
-  fit.rms_before = (before / static_cast<double>(rows)).cwiseSqrt();
-  fit.rms_after = (after / static_cast<double>(rows)).cwiseSqrt();
+  fit.joint_rms_before = VectorX::Zero(n);
+  fit.joint_rms_after = VectorX::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    fit.joint_rms_before[i] = rms(axes + i, no_payload);
+    fit.joint_rms_after[i] = rms(axes + i, theta);
+  }
   fit.samples = static_cast<int>(rows);
-  (void)yy;
   if (fit.condition > 1e6) {
     throw Error("payload: mass and centre of mass not excited (condition " +
                 std::to_string(fit.condition) +
