@@ -36,12 +36,15 @@ void plot_series(std::ostream& s, const PlotContext& c, const std::vector<Series
     list += (list.empty() ? "" : ", ") + c.data + " using 1:" + col(x.column) + " " + x.style +
             " title " + gnuplot_quote(x.title);
   }
+  // Every time axis spans the log exactly, so that the panels of a figure line up (gnuplot's
+  // autoscale rounds to a tic: a panel with data ended at 12 s beside an empty one at 10.5 s).
+  const double t1 = c.t_end > c.t_begin ? c.t_end : c.t_begin + 1.0;
+  s << "set xrange [" << c.t_begin << ":" << t1 << "]\n";
   if (list.empty()) {
-    // An empty frame over the log's span: gnuplot refuses to autoscale on no data.
-    const double t1 = c.t_end > c.t_begin ? c.t_end : c.t_begin + 1.0;
-    s << "unset logscale y\nset xrange [" << c.t_begin << ":" << t1 << "]\nset yrange [0:1]\n"
+    // An empty frame: gnuplot refuses to autoscale y on no data.
+    s << "unset logscale y\nset yrange [0:1]\n"
       << "set label 1 " << gnuplot_quote(enhanced(why)) << " at graph 0.5, 0.5 center\n"
-      << "plot 2 notitle\nunset label 1\nset autoscale x\nset autoscale y\n";
+      << "plot 2 notitle\nunset label 1\nset autoscale y\n";
     return;
   }
   if (log_scale) s << "set logscale y\n";

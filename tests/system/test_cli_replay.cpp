@@ -133,6 +133,22 @@ TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
       EXPECT_EQ(read_text(png).substr(1, 3), "PNG") << png;
       EXPECT_GT(fs::file_size(png), 10000u) << png;
     }
+    // Every panel of the time plots spans the same interval (the log's), so that they line up:
+    // one `set xrange` before each plot, all equal, and never gnuplot's rounded autoscale.
+    for (const char* name : {"joints", "force", "line_point", "condition"}) {
+      const std::string script = read_text(dir_ / ("out_" + type) / (std::string(name) + ".gp"));
+      EXPECT_FALSE(contains(script, "set autoscale x")) << name;
+      std::size_t at = 0, ranges = 0;
+      std::string first;
+      while ((at = script.find("set xrange [", at)) != std::string::npos) {
+        const std::string range = script.substr(at, script.find('\n', at) - at);
+        if (first.empty()) first = range;
+        EXPECT_EQ(range, first) << name;
+        ++ranges;
+        ++at;
+      }
+      EXPECT_GE(ranges, 1u) << name;
+    }
     for (const auto& f : fs::directory_iterator(dir_ / ("out_" + type)))
       EXPECT_FALSE(contains(f.path().string(), ".partial")) << f.path();
     EXPECT_FALSE(fs::exists(dir_ / ("out_" + type) / "metrics.json")) << "no truth, no metrics";
