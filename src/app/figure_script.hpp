@@ -16,7 +16,7 @@ namespace extwrench::detail {
 enum Col : int {
   kT = 0,
   kContact,
-  kF = 2,          // estimated force, W
+  kF = 2,          // estimated force, W (NaN where partial: kFPartial)
   kFt = 5,         // true force, W
   kL = 8,          // p̂ of eq. (20)
   kDir = 11,       // unit direction of the line of action
@@ -28,7 +28,8 @@ enum Col : int {
   kIll,            // 1 when the estimate is flagged ill_conditioned (damped)
   kTrueContact,
   kErrF,
-  kQ
+  kFPartial,  // the force of estimates flagged partial (observable part only), W
+  kQ = kFPartial + 3
 };
 
 inline constexpr const char* kAxis[] = {"x", "y", "z"};

@@ -86,6 +86,7 @@ std::string force_script(const PlotContext& c, const Figure& f) {
     s << "set ylabel 'F_" << kAxis[k] << " [N]'\nunset xlabel\n";
     plot_series(s, c,
                 {{kF + k, "with lines lw 2 lc rgb '#1f77b4'", "estimated"},
+                 {kFPartial + k, "with points pt 7 ps 0.5 lc rgb '#999999'", "partial"},
                  {kFt + k, "with lines lw 2 dt 2 lc rgb '#d62728'", "true"}},
                 "no force estimated (no contact detected)");
   }
@@ -252,8 +253,12 @@ void FigureRecorder::add(const Sample& sample, const ContactEstimate& estimate) 
 
 void FigureRecorder::estimate_columns(const Sample& s, const ContactEstimate& e, double* r) {
   r[kContact] = e.contact ? 1.0 : 0.0;
+  // A partial estimate is the observable part of the force only (docs/estimator.md#partial-
+  // observability): drawn apart, so that it is not read as the force.
+  const bool partial = e.contact && e.has(EstimateFlag::kPartial);
   for (int k = 0; k < 3; ++k) {
-    r[kF + k] = e.contact ? e.force_W[k] : kNaN;
+    r[kF + k] = e.contact && !partial ? e.force_W[k] : kNaN;
+    r[kFPartial + k] = partial ? e.force_W[k] : kNaN;
     r[kL + k] = e.contact ? e.line_point_W[k] : kNaN;
     r[kDir + k] = e.contact ? e.line_direction_W[k] : kNaN;
     r[kP + k] = e.contact ? e.point_W[k] : kNaN;
