@@ -43,6 +43,22 @@ std::vector<Sample> panda_log(const Model& model) {
   return samples;
 }
 
+// The log, its fit part's size (the first kFitFraction) and the calibration made on that part.
+struct HeldOutRun {
+  std::vector<Sample> samples;
+  std::size_t first = 0;
+  Calibration cal;
+};
+HeldOutRun calibrated_on_fit_part(const EstimatorConfig& cfg) {
+  HeldOutRun run;
+  run.samples = panda_log(cfg.robot.model);
+  run.first = static_cast<std::size_t>(kFitFraction * static_cast<double>(run.samples.size()));
+  run.cal = calibrate(
+      cfg.robot.model, cfg.options,
+      std::vector<Sample>(run.samples.begin(), run.samples.begin() + static_cast<long>(run.first)));
+  return run;
+}
+
 TEST(CalibrationPanda, HeldOutFreeMotionStaysQuietAndLightTouchesGetDetectable) {
   if (!fs::exists(panda_dir() / "log.csv")) GTEST_SKIP() << "no " << panda_dir();
   const EstimatorConfig cfg = panda_config();
@@ -161,11 +177,7 @@ TEST(CalibrationPanda, PushSuperposedOnTheRealTorquesIsDetectedOnTheWrist) {
   if (!fs::exists(panda_dir() / "log.csv")) GTEST_SKIP() << "no " << panda_dir();
   const EstimatorConfig cfg = panda_config();
   const Model& model = cfg.robot.model;
-  const std::vector<Sample> free = panda_log(model);
-  const auto first = static_cast<std::size_t>(kFitFraction * static_cast<double>(free.size()));
-  const Calibration cal =
-      calibrate(model, cfg.options,
-                std::vector<Sample>(free.begin(), free.begin() + static_cast<long>(first)));
+  const auto [free, first, cal] = calibrated_on_fit_part(cfg);
   const std::size_t start = free.size() * 8 / 10;
   Data data(model);
   Matrix6X J = Matrix6X::Zero(6, model.nq());
@@ -267,11 +279,7 @@ TEST(CalibrationPanda, PushesAtSurfacePointsAreDetectedWithin50ms) {
   if (!fs::exists(panda_dir() / "log.csv")) GTEST_SKIP() << "no " << panda_dir();
   const EstimatorConfig cfg = panda_config(kFilteredObserver);
   const Model& model = cfg.robot.model;
-  const std::vector<Sample> free = panda_log(model);
-  const auto first = static_cast<std::size_t>(kFitFraction * static_cast<double>(free.size()));
-  const Calibration cal =
-      calibrate(model, cfg.options,
-                std::vector<Sample>(free.begin(), free.begin() + static_cast<long>(first)));
+  const auto [free, first, cal] = calibrated_on_fit_part(cfg);
   const std::size_t start = free.size() * 8 / 10;
   const std::vector<SurfacePush> pushes = surface_pushes(model, cfg.robot.geometry, free[start].q);
   Data data(model);
