@@ -13,11 +13,13 @@
 //   y_{k+1} = y_k + (1 − e^{−ω Δt}) (x_{k+1} − y_k),   ω = 2π cutoff,
 //
 // so DC passes with gain 1 and a constant input is reproduced exactly. The same step serves the
-// estimator (ResidualFilter) and the calibration's series (residual_filter_step), so the
-// thresholds are computed on bit-for-bit the signal the detector compares with them.
+// estimator (ResidualFilter) and the calibration (residual_filter_step on the residual and on
+// each regressor: the filter is linear), so the thresholds are computed on the signal the
+// detector compares with them, to rounding.
 #pragma once
 
 #include <cmath>
+#include <numbers>
 
 #include "extwrench/core/types.hpp"
 
@@ -25,7 +27,7 @@ namespace extwrench {
 
 /// Weight (1 − e^{−ω Δt}) of one step of a section at `cutoff` Hz over `dt` seconds.
 [[nodiscard]] inline double residual_filter_weight(double cutoff, double dt) noexcept {
-  return -std::expm1(-2.0 * 3.14159265358979323846 * cutoff * dt);
+  return -std::expm1(-2.0 * std::numbers::pi * cutoff * dt);
 }
 
 /// One step of both sections for one channel: s1, s2 the section states, x the new input.
