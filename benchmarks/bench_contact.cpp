@@ -235,6 +235,20 @@ void register_contact_benchmarks() {
       ->Iterations(1)
       ->Repetitions(1)
       ->Unit(benchmark::kMillisecond);
+  // The machine's own tail: a dependent chain of multiply-adds as long as the update above
+  // (~1.8 µs), no memory, no branches that depend on data. Whatever its p99.9 / median is, no
+  // code of that length can do better on this machine (BENCHMARKS.md, "Jitter").
+  benchmark::RegisterBenchmark("BM_Latency_Spin/1080_fma",
+                               [](benchmark::State& state) {
+                                 double x = 1.0001;
+                                 measure_latency(state, kLatencyCalls, [&] {
+                                   for (int k = 0; k < 1080; ++k) x = x * 1.0000001 + 1e-9;
+                                   benchmark::DoNotOptimize(x);
+                                 });
+                               })
+      ->Iterations(1)
+      ->Repetitions(1)
+      ->Unit(benchmark::kMillisecond);
 }
 
 }  // namespace extwrench::bench
