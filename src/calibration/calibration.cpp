@@ -7,7 +7,6 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
-#include "extwrench/observer/residual_filter.hpp"
 #include "friction_fit.hpp"
 #include "model_check.hpp"
 #include "payload_fit.hpp"
@@ -466,17 +465,13 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   }
 
   cal.observer_gain = gains;
-  cal.residual_cutoff = options.residual_cutoff.size() == 1
-                            ? VectorX::Constant(n, options.residual_cutoff[0])
-                            : options.residual_cutoff;
+  cal.residual_cutoff = per_joint(options.residual_cutoff, n);
   // The residual filter: every series from here on is the filtered residual (r is linear in θ,
   // so filtering r⁰ and each regressor gives the estimator's filtered residual, to rounding).
   for (int i = 0; i < n; ++i) {
     const double cutoff = cal.residual_cutoff[i];
     if (!(cutoff > 0.0)) continue;
-    std::vector<double> weight(samples.size(), 0.0);
-    for (std::size_t k = 1; k < samples.size(); ++k)
-      weight[k] = residual_filter_weight(cutoff, samples[k].t - samples[k - 1].t);
+    const std::vector<double> weight = calibration_detail::residual_filter_weights(samples, cutoff);
     for (std::vector<JointSeries>* s : {&series, &before}) {
       JointSeries& js = (*s)[static_cast<std::size_t>(i)];
       calibration_detail::apply_residual_filter(weight, js.r0);
@@ -532,10 +527,8 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
       const VectorX& g = gravity_torques(m, data, samples[k].q);
       for (int i = 0; i < n; ++i) gravity[static_cast<std::size_t>(i)][k] = g[i];
     }
-    std::vector<double> times(samples.size());
-    for (std::size_t k = 0; k < samples.size(); ++k) times[k] = samples[k].t;
-    calibration_detail::check_joints(series, before, fits, gravity, times, cal.residual_cutoff, use,
-                                     cal.model_check);
+    calibration_detail::check_joints(series, before, fits, gravity, samples, cal.residual_cutoff,
+                                     use, cal.model_check);
   }
   if (options.sensor.type != SensorType::kNone)
     sensor_calibration(model, options, samples, use, o, cal);

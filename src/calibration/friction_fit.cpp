@@ -99,6 +99,13 @@ void filter_regressor(const std::vector<double>& phi, const std::vector<double>&
   apply_residual_filter(residual_filter_weight, z);
 }
 
+std::vector<double> residual_filter_weights(const std::vector<Sample>& samples, double cutoff) {
+  std::vector<double> weight(samples.size(), 0.0);
+  for (std::size_t k = 1; k < samples.size(); ++k)
+    weight[k] = residual_filter_weight(cutoff, samples[k].t - samples[k - 1].t);
+  return weight;
+}
+
 void apply_residual_filter(const std::vector<double>& weight, std::vector<double>& x) {
   if (weight.empty()) return;
   double s1 = 0.0, s2 = 0.0;

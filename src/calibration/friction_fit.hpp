@@ -45,6 +45,11 @@ void filter_regressor(const std::vector<double>& phi, const std::vector<double>&
 /// The residual filter over a series in place, with its weights per step (none when empty).
 void apply_residual_filter(const std::vector<double>& weight, std::vector<double>& x);
 
+/// The residual filter's weight per step at `cutoff` Hz over the samples' time stamps (the
+/// weight of step k, from sample k − 1 to k, at k; 0 at k = 0).
+[[nodiscard]] std::vector<double> residual_filter_weights(const std::vector<Sample>& samples,
+                                                          double cutoff);
+
 /// Throws extwrench::Error when joint `joint` (1-based) does not move enough, in both
 /// directions, to identify its viscous and Coulomb friction over the samples in `use`.
 void check_excitation(const JointSeries& s, const std::vector<char>& use, int joint,

@@ -4,9 +4,6 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
-#include <utility>
-
-#include "extwrench/observer/residual_filter.hpp"
 
 namespace extwrench::calibration_detail {
 namespace {
@@ -23,25 +20,16 @@ constexpr double kOffsetSpreads = 2.0;
 constexpr double kSuggestedCutoff = 20.0;  // [Hz]
 constexpr double kHighFrequencyLeft = 0.3;
 
-/// Variance over the used samples of r, and of r through the residual filter at `cutoff`.
-std::pair<double, double> variance_and_filtered(const std::vector<double>& r,
-                                                const std::vector<double>& times,
-                                                const std::vector<char>& use, double cutoff) {
-  double s1 = 0.0, s2 = 0.0, n = 0.0, sum = 0.0, sum2 = 0.0, fsum = 0.0, fsum2 = 0.0;
-  for (std::size_t k = 0; k < r.size(); ++k) {
-    const double f =
-        k == 0 ? 0.0
-               : residual_filter_step(residual_filter_weight(cutoff, times[k] - times[k - 1]), r[k],
-                                      s1, s2);
+/// Variance of x over the used samples.
+double variance(const std::vector<double>& x, const std::vector<char>& use) {
+  double n = 0.0, sum = 0.0, sum2 = 0.0;
+  for (std::size_t k = 0; k < x.size(); ++k) {
     if (!use[k]) continue;
     n += 1;
-    sum += r[k];
-    sum2 += r[k] * r[k];
-    fsum += f;
-    fsum2 += f * f;
+    sum += x[k];
+    sum2 += x[k] * x[k];
   }
-  if (n < 2) return {0.0, 0.0};
-  return {sum2 / n - (sum / n) * (sum / n), fsum2 / n - (fsum / n) * (fsum / n)};
+  return n < 2 ? 0.0 : sum2 / n - (sum / n) * (sum / n);
 }
 
 std::string num(double x) {
@@ -54,9 +42,11 @@ std::string num(double x) {
 
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
                   const std::vector<JointFrictionFit>& after,
-                  const std::vector<std::vector<double>>& gravity, const std::vector<double>& times,
-                  const VectorX& residual_cutoff, const std::vector<char>& use, ModelCheck& check) {
+                  const std::vector<std::vector<double>>& gravity,
+                  const std::vector<Sample>& samples, const VectorX& residual_cutoff,
+                  const std::vector<char>& use, ModelCheck& check) {
   const std::size_t n = series.size();
+  const std::vector<double> suggested = residual_filter_weights(samples, kSuggestedCutoff);
   check.joint_rms = VectorX::Zero(static_cast<Eigen::Index>(n));
   std::vector<double> phi, z;
   for (std::size_t i = 0; i < n; ++i) {
@@ -86,19 +76,21 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     filter_regressor(gravity[i], s.alpha, z, s.filter_weight);
     const LineFit g = fit_line(z, after[i].residual, use);
     if (g.r2 >= kJointShare) {
-      check.patterns.push_back(
-          {"gravity", joint, g.r2,
-           "joint " + std::to_string(joint) + ": the calibrated residual follows g(q) (" +
-               num(100.0 * g.slope) + " % of it, R^2 " + num(g.r2) +
-               "): a gravity / mass error in the model (a payload? --payload, with a base sensor)"});
+      check.patterns.push_back({"gravity", joint, g.r2,
+                                "joint " + std::to_string(joint) +
+                                    ": the calibrated residual follows g(q) (" +
+                                    num(100.0 * g.slope) + " % of it, R^2 " + num(g.r2) +
+                                    "): a gravity / mass error in the model (a payload? --payload, "
+                                    "with a base sensor)"});
     }
     // Mostly above ~20 Hz (unfiltered joints only): the velocity's noise through K B(q), or the
     // torque's, which the residual filter removes (docs/estimator.md#residual-filter).
     if (residual_cutoff[static_cast<Eigen::Index>(i)] > 0.0) continue;
-    const auto [variance, filtered] =
-        variance_and_filtered(after[i].residual, times, use, kSuggestedCutoff);
-    if (variance > 0.0 && filtered <= kHighFrequencyLeft * variance) {
-      const double share = 1.0 - filtered / variance;
+    std::vector<double> low = after[i].residual;
+    apply_residual_filter(suggested, low);
+    const double total = variance(after[i].residual, use), filtered = variance(low, use);
+    if (total > 0.0 && filtered <= kHighFrequencyLeft * total) {
+      const double share = 1.0 - filtered / total;
       check.patterns.push_back(
           {"high_frequency", joint, share,
            "joint " + std::to_string(joint) + ": " + num(100.0 * share) +

@@ -53,9 +53,9 @@ ContactDetector::ContactDetector(const DetectionOptions& options, int n, double 
     : options_(options), release_settle_time_(release_settle_time) {
   validate(options, n);
   const VectorX& t = options.tau_min;
-  tau_min_ = t.size() == 1 ? VectorX::Constant(n, t[0]) : t;
+  tau_min_ = per_joint(t, n);
   const VectorX& b = options.tau_per_speed;
-  tau_speed_ = b.size() == 0 ? VectorX::Zero(n) : b.size() == 1 ? VectorX::Constant(n, b[0]) : b;
+  tau_speed_ = b.size() == 0 ? VectorX::Zero(n) : per_joint(b, n);
   speed_dependent_ = (tau_speed_.array() > 0.0).any();
   threshold_ = tau_min_;
   joint_over_.setConstant(n, false);

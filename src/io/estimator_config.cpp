@@ -142,8 +142,7 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
   } catch (const Error& e) {
     rd.fail(node, "calibration", std::string("cannot load '") + path.string() + "': " + e.what());
   }
-  const VectorX gains =
-      o.observer_gain.size() == 1 ? VectorX::Constant(n, o.observer_gain[0]) : o.observer_gain;
+  const VectorX gains = per_joint(o.observer_gain, n);
   if (!gains.isApprox(cal.observer_gain, 1e-12)) {
     rd.fail(node, "calibration",
             "'" + path.string() + "' was made with observer.gain " +
@@ -153,8 +152,7 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
   // The thresholds hold for the residual filtered as it was at calibration: taken from the file
   // unless set here, and then it must be the same.
   const YAML::Node ob = root["observer"];
-  const VectorX cutoff = o.residual_cutoff.size() == 1 ? VectorX::Constant(n, o.residual_cutoff[0])
-                                                       : o.residual_cutoff;
+  const VectorX cutoff = per_joint(o.residual_cutoff, n);
   if (!(ob && ob["residual_cutoff"])) {
     o.residual_cutoff = cal.residual_cutoff;
   } else if (cutoff != cal.residual_cutoff) {

@@ -14,7 +14,7 @@ VectorX MomentumObserver::checked_gains(const VectorX& gains, int n) {
     throw Error("MomentumObserver: observer gain: expected 1 or " + std::to_string(n) +
                 " values, got " + std::to_string(gains.size()));
   }
-  VectorX k = gains.size() == 1 ? VectorX::Constant(n, gains[0]) : gains;
+  VectorX k = per_joint(gains, n);
   for (int i = 0; i < n; ++i) {
     if (!std::isfinite(k[i]) || !(k[i] > 0.0)) {
       throw Error("MomentumObserver: observer gain[" + std::to_string(i) +

@@ -22,6 +22,12 @@ using MatrixX = Eigen::MatrixXd;
 using Matrix6X = Eigen::Matrix<double, 6, Eigen::Dynamic>;
 using Matrix3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
 
+/// A per-joint option given as one value for all joints or one per joint: its n values (a value
+/// of any other size is returned as it is; the options' validate() rejects it).
+[[nodiscard]] inline VectorX per_joint(const VectorX& v, int n) {
+  return v.size() == 1 ? VectorX::Constant(n, v[0]) : v;
+}
+
 /// Skew-symmetric matrix S(v) such that S(v) w = v × w.
 inline Matrix3 skew(const Vector3& v) {
   Matrix3 s;

@@ -46,7 +46,7 @@ class ResidualFilter {
   /// cutoff [Hz] per channel: size 1 (every channel) or n, entries ≥ 0 (0: none). Entries that
   /// are not finite and > 0 count as 0; options are checked where they are read (validate).
   ResidualFilter(const VectorX& cutoff, int n)
-      : cutoff_(cutoff.size() == 1 ? VectorX::Constant(n, cutoff[0]) : cutoff),
+      : cutoff_(per_joint(cutoff, n)),
         weight_(VectorX::Zero(n)),
         s1_(VectorX::Zero(n)),
         s2_(VectorX::Zero(n)) {
