@@ -92,6 +92,12 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
                                const Eigen::Ref<const VectorX>& tau) noexcept {
   const Status s = observer_.reset(model_, data_, t, q, dq, tau);
   if (!s.ok()) return s;
+  if (options_.drift && observer_.friction().offset != initial_offset_) {
+    // Back to the configured offsets exactly, and the observer started from them as a fresh
+    // estimator's (o + (o₀ − o) is not o₀ in floating point).
+    observer_.set_offset(initial_offset_);
+    (void)observer_.reset(model_, data_, t, q, dq, tau);  // the same inputs passed above
+  }
   initialized_ = true;
   t_ = t;
   dq_prev_ = dq;
@@ -110,9 +116,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
     tare_.request(options_.sensor.tare_samples);
   }
   out_.residual.setZero();
-  if (options_.drift) {  // back to the configured offsets and bias, as a fresh estimator
-    drift_delta_ = initial_offset_ - observer_.friction().offset;
-    observer_.shift_offset(drift_delta_);
+  if (options_.drift) {  // back to the configured bias, as a fresh estimator (offsets: above)
     if (options_.sensor.tare_samples == 0) tare_.bias_S = options_.sensor.bias_S;
     drift_quiet_since_ = t;
     drift_t_prev_ = t;

@@ -69,6 +69,10 @@ void MomentumObserver::shift_offset(const Eigen::Ref<const VectorX>& delta) noex
   }
 }
 
+void MomentumObserver::set_offset(const Eigen::Ref<const VectorX>& offset) noexcept {
+  friction_.offset = offset;
+}
+
 void MomentumObserver::integrand(const Data& data, const Eigen::Ref<const VectorX>& dq) noexcept {
   extwrench::friction_torque(friction_, dq, tau_f_);
   // γ = Cᵀq̇ − g − τ_f: the state-dependent part of the integrand of (4).

@@ -51,6 +51,10 @@ class MomentumObserver {
   /// the current interval's integrand corrected like set_friction. Needs friction().offset of
   /// size n (set_friction with an offset first).
   void shift_offset(const Eigen::Ref<const VectorX>& delta) noexcept;
+  /// Sets the friction's torque offsets o_i to `offset` (n) exactly, for a reset to follow
+  /// (the current interval's integrand is not corrected). Allocation-free; needs friction().offset
+  /// of size n.
+  void set_offset(const Eigen::Ref<const VectorX>& offset) noexcept;
 
   /// Starts (or restarts) the observer at time t: r = 0, m(0) = B(q) q̇ (momentum_terms on
   /// `data`). The torque of the interval [t, t_1) is `tau`; the overload without it takes the
