@@ -80,7 +80,7 @@ const MatrixX& crba(const Model& model, Data& data, const Eigen::Ref<const Vecto
   // along a chain the child's composite is carried in registers.
   const int nb = model.num_bodies();
   // sin_cos_poly, not glibc's sincos (~11 ns per joint): within 2.3e-16 of it.
-  for (int j = 0; j < nb - 1; ++j) detail::sin_cos_poly(q[j], data.sin_q[j], data.cos_q[j]);
+  detail::sin_cos_poly_n(q.data(), data.sin_q.data(), data.cos_q.data(), nb - 1);
   data.X_WB[0] = Pose{};
   data.S[0].setZero();
   for (int i = 1; i < nb; ++i) {

@@ -1,5 +1,6 @@
 #include "extwrench/dynamics/data.hpp"
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 namespace extwrench {
@@ -36,6 +37,43 @@ JointRotation joint_rotation(const Joint& joint) {
   return out;
 }
 
+/// A_i: a rotation taking e_z to the unit axis (the identity for +z, so that a model whose axes
+/// are all +z keeps its body frames).
+Matrix3 axis_alignment(const Joint& joint) {
+  if (joint.axis == Vector3::UnitZ()) return Matrix3::Identity();
+  return Eigen::Quaterniond::FromTwoVectors(Vector3::UnitZ(), joint.axis).toRotationMatrix();
+}
+
+/// Data::aligned of every body, from the model's joints and inertias.
+std::vector<Data::AlignedBody> aligned_bodies(const Model& model) {
+  const auto nb = static_cast<std::size_t>(model.num_bodies());
+  std::vector<Data::AlignedBody> out(nb);
+  for (std::size_t i = 0; i < nb; ++i) {
+    Data::AlignedBody& b = out[i];
+    if (i > 0 && i < model.joints.size()) {
+      const Joint& joint = model.joints[i];
+      const auto p = static_cast<std::size_t>(model.parents[i]);
+      b.alignment = axis_alignment(joint);
+      const Matrix3 parent_T = out[p].alignment.transpose();
+      b.rotation = parent_T * joint.placement.rotation * b.alignment;
+      b.rotation_T = b.rotation.transpose();
+      b.translation = parent_T * joint.placement.translation;
+      b.revolute = joint.type == JointType::kRevolute ? 1.0 : 0.0;
+      if (joint.type != JointType::kRevolute)
+        b.slide = parent_T * (joint.placement.rotation * joint.axis);
+    }
+    const Inertia& inertia = model.bodies[i].inertia;
+    const Vector3& c = inertia.com;
+    const Matrix3 inertia_O =
+        inertia.inertia_com +
+        inertia.mass * (c.squaredNorm() * Matrix3::Identity() - c * c.transpose());
+    b.mass = inertia.mass;
+    b.first_moment = inertia.mass * (b.alignment.transpose() * c);
+    b.inertia_O = b.alignment.transpose() * inertia_O * b.alignment;
+  }
+  return out;
+}
+
 template <typename T>
 bool sized(const std::vector<T>& v, std::size_t size) {
   return v.size() == size;
@@ -67,6 +105,10 @@ Data::Data(const Model& model) {
     S_B[i] = r.S_B;
     slide_P[i] = r.slide_P;
   }
+  aligned = aligned_bodies(model);
+  w_J.assign(nb, Vector3::Zero());
+  a_J.assign(nb, Vector6::Zero());
+  f_J.assign(nb, Vector6::Zero());
   X_WB.assign(nb, Pose{});
   S.assign(nb, Vector6::Zero());
   mass.assign(nb, 0.0);
@@ -115,7 +157,8 @@ bool Data::matches(const Model& model) const {
       sized(composite_mass, nb) && sized(composite_first_moment, nb) &&
       sized(composite_inertia_O, nb) && sized(composite_first_moment_B, nb) &&
       sized(gravity_B, nb) && sized(gravity_lin_B, nb) && sized(gravity_moment_B, nb) &&
-      sized(Ic, nb) && sized(Bc, nb) && sized(Sdot, nb);
+      sized(Ic, nb) && sized(Bc, nb) && sized(Sdot, nb) && sized(w_J, nb) && sized(a_J, nb) &&
+      sized(f_J, nb);
   const bool joints_sized = tau.size() == n && M.rows() == n && M.cols() == n && C.rows() == n &&
                             C.cols() == n && momentum.size() == n &&
                             coriolis_transpose_dq.size() == n && gravity_torque.size() == n &&
@@ -132,7 +175,7 @@ bool Data::matches(const Model& model) const {
       return false;
     }
   }
-  return true;
+  return aligned == aligned_bodies(model);
 }
 
 }  // namespace extwrench

@@ -53,70 +53,175 @@ const VectorX& backward_pass(const Model& model, Data& data,
 
 }  // namespace
 
+namespace {
+
+// rnea's 3-vectors as three doubles: Eigen's Vector3 arithmetic under SSE2 mixes 2-double
+// packets with scalars, and rebuilt packets from scalars through the stack, each one a
+// store-forwarding stall (they were most of rnea's time in `perf annotate`).
+struct Vec {
+  double x, y, z;
+};
+[[gnu::always_inline]] inline Vec operator+(const Vec& a, const Vec& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+[[gnu::always_inline]] inline Vec operator*(double k, const Vec& a) {
+  return {k * a.x, k * a.y, k * a.z};
+}
+[[gnu::always_inline]] inline Vec cross(const Vec& a, const Vec& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+/// M x for a column-major 3x3.
+[[gnu::always_inline]] inline Vec times(const Matrix3& M, const Vec& x) {
+  const double* m = M.data();
+  return {m[0] * x.x + m[3] * x.y + m[6] * x.z, m[1] * x.x + m[4] * x.y + m[7] * x.z,
+          m[2] * x.x + m[5] * x.y + m[8] * x.z};
+}
+/// Rz(c, s) x and Rz(c, s)^T x: the joint's turn of the first two coordinates.
+[[gnu::always_inline]] inline Vec rotate_z(double c, double s, const Vec& x) {
+  return {c * x.x - s * x.y, s * x.x + c * x.y, x.z};
+}
+[[gnu::always_inline]] inline Vec rotate_z_inverse(double c, double s, const Vec& x) {
+  return {c * x.x + s * x.y, c * x.y - s * x.x, x.z};
+}
+[[gnu::always_inline]] inline Vec load(const Vector6& v, int offset) {
+  return {v[offset], v[offset + 1], v[offset + 2]};
+}
+[[gnu::always_inline]] inline void store(const Vec& x, Vector3& v, int offset) {
+  v[offset] = x.x;
+  v[offset + 1] = x.y;
+  v[offset + 2] = x.z;
+}
+[[gnu::always_inline]] inline Vec load(const Vector3& v, int offset = 0) {
+  return {v[offset], v[offset + 1], v[offset + 2]};
+}
+[[gnu::always_inline]] inline void store(const Vec& x, Vector6& v, int offset) {
+  v[offset] = x.x;
+  v[offset + 1] = x.y;
+  v[offset + 2] = x.z;
+}
+
+}  // namespace
+
 const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& ddq,
                     std::span<const ExternalWrench> external) {
-  // One pass: poses and S as in forward_kinematics, then Newton-Euler of each body about its
-  // CoM with the constant body-axes inertia I_c, so that no world inertia R I_c R^T is formed
-  // (that rotation was most of forward_kinematics; rnea_no_kinematics reuses it instead).
+  // Featherstone's form in each body's joint-aligned frame J_i (Data::aligned): the motion
+  // comes into J_i through E'_i(q)^T = Rz(q)^T P'^T, Newton-Euler uses J_i's constant mass
+  // properties about its origin, and the wrench goes back through E'_i. The joint is e_z there,
+  // so S q_dot, S q_ddot, v x S q_dot and S^T f are a few scalars; no world pose is formed
+  // (docs/algorithms.md, "Inverse dynamics").
   const int nb = model.num_bodies();
-  data.X_WB[0] = Pose{};
-  data.S[0].setZero();
-  data.v[0].setZero();
-  data.a[0].setZero();
-  // Gravity trick: the base accelerates with -g (docs/method.md).
-  data.a[0].head<3>() = -model.gravity;
+  // Before the angles below: it writes data.sin_q, data.cos_q of its own.
+  if (!external.empty()) forward_poses(model, data, q);
+  detail::sin_cos_poly_n(q.data(), data.sin_q.data(), data.cos_q.data(), nb - 1);
+  // Prismatic joints turn by 0: (c, s) = (1, 0) keeps one path for both types.
+  for (int j = 0; j < nb - 1; ++j) {
+    const double r = data.aligned[static_cast<std::size_t>(j + 1)].revolute;
+    data.sin_q[j] *= r;
+    data.cos_q[j] = r * data.cos_q[j] + (1.0 - r);
+  }
+  // Gravity trick: the base accelerates with -g (docs/method.md). J_0 is the world frame.
   {
-    // Link 0 is at rest in the world frame: f_0 = [m (-g); c x m (-g)].
-    const Inertia& inertia = model.bodies[0].inertia;
-    const Vector3 F = -inertia.mass * model.gravity;
-    data.f[0] << F, inertia.com.cross(F);
+    const Data::AlignedBody& b = data.aligned[0];
+    const Vec a0 = -1.0 * load(model.gravity);
+    const Vec zero{0.0, 0.0, 0.0};
+    store(zero, data.w_J[0], 0);
+    store(a0, data.a_J[0], 0);
+    store(zero, data.a_J[0], 3);
+    store(b.mass * a0, data.f_J[0], 0);
+    store(cross(load(b.first_moment), a0), data.f_J[0], 3);
   }
-  // The parent's motion [v_O; w], [a_O; w_dot] is carried in registers along a chain (body
-  // i - 1), reloaded from data only at a branching of a tree.
-  Vector3 v_O = Vector3::Zero();
-  Vector3 w = Vector3::Zero();
-  Vector3 a_O = -model.gravity;
-  Vector3 w_dot = Vector3::Zero();
-  Pose X_parent;  // likewise the parent's pose
-  detail::joint_sin_cos(model, data, q);
   for (int i = 1; i < nb; ++i) {
-    const int p = model.parents[i];
-    if (p != i - 1) {
-      X_parent = data.X_WB[p];
-      v_O = data.v[p].head<3>();
-      w = data.v[p].tail<3>();
-      a_O = data.a[p].head<3>();
-      w_dot = data.a[p].tail<3>();
-    }
-    Matrix3 R;
-    Vector3 O;
-    Vector3 s_lin;
-    Vector3 s_ang;
-    detail::joint_kinematics(model, data, i, X_parent, q[i - 1], R, O, s_lin, s_ang);
-    detail::propagate_motion<true>(s_lin, s_ang, dq[i - 1], ddq[i - 1], v_O, w, a_O, w_dot);
-    const Inertia& inertia = model.bodies[i].inertia;
-    const Vector3 c = R * inertia.com + O;
-    const Vector3 v_c = v_O + w.cross(c);
-    const Vector3 w_B = R.transpose() * w;
-    Vector3 F;
-    Vector3 N;
-    detail::newton_euler_about_com(inertia, R, c, v_c, w, a_O, w_dot, w_B,
-                                   inertia.inertia_com * w_B, F, N);
-    data.X_WB[i].rotation = R;
-    data.X_WB[i].translation = O;
-    data.S[i].head<3>() = s_lin;
-    data.S[i].tail<3>() = s_ang;
-    data.v[i].head<3>() = v_O;
-    data.v[i].tail<3>() = w;
-    data.a[i].head<3>() = a_O;
-    data.a[i].tail<3>() = w_dot;
-    data.f[i].head<3>() = F;
-    data.f[i].tail<3>() = N;
-    X_parent.rotation = R;
-    X_parent.translation = O;
+    const auto ui = static_cast<std::size_t>(i);
+    const auto up = static_cast<std::size_t>(model.parents[ui]);
+    // The parent's angular velocity w, angular acceleration w_dot and the classical linear
+    // acceleration a of its origin (no linear velocity is needed: Newton-Euler about an origin
+    // uses its acceleration only).
+    Vec w = load(data.w_J[up], 0);
+    Vec a = load(data.a_J[up], 0);
+    Vec w_dot = load(data.a_J[up], 3);
+    const Data::AlignedBody& b = data.aligned[ui];
+    const double c = data.cos_q[i - 1];
+    const double s = data.sin_q[i - 1];
+    const double qd = dq[i - 1];
+    const double qdd = ddq[i - 1];
+    const double r = b.revolute;
+    const Vec t = load(b.translation) + q[i - 1] * load(b.slide);
+    // The acceleration of this joint's origin as a point of the parent, then all into J_i.
+    a = rotate_z_inverse(c, s, times(b.rotation_T, a + cross(w_dot, t) + cross(w, cross(w, t))));
+    w = rotate_z_inverse(c, s, times(b.rotation_T, w));
+    w_dot = rotate_z_inverse(c, s, times(b.rotation_T, w_dot));
+    // The joint, e_z in J_i: revolute w += e_z q_dot, w_dot += e_z q_ddot + w x e_z q_dot;
+    // prismatic: the origin slides, a += e_z q_ddot + 2 w x e_z q_dot (Coriolis).
+    const double coriolis = 2.0 * (1.0 - r) * qd;  // 0 for a revolute joint
+    a.x += coriolis * w.y;
+    a.y -= coriolis * w.x;
+    a.z += (1.0 - r) * qdd;
+    const double turn = r * qd;  // 0 for a prismatic joint
+    w.z += turn;
+    w_dot.x += turn * w.y;
+    w_dot.y -= turn * w.x;
+    w_dot.z += r * qdd;
+    // Eqs. (7)-(8) about J_i's origin, with h = m c and I_O constant in J_i.
+    const Vec h = load(b.first_moment);
+    const Vec F = b.mass * a + cross(w_dot, h) + cross(w, cross(w, h));
+    const Vec N = times(b.inertia_O, w_dot) + cross(w, times(b.inertia_O, w)) + cross(h, a);
+    store(w, data.w_J[ui], 0);
+    store(a, data.a_J[ui], 0);
+    store(w_dot, data.a_J[ui], 3);
+    store(F, data.f_J[ui], 0);
+    store(N, data.f_J[ui], 3);
   }
-  backward_pass(model, data, external);
+  if (!external.empty()) {
+    // World wrenches into J_i: the body's world pose (forward_poses, run first) times A_i.
+    for (const ExternalWrench& e : external) {
+      const auto ub = static_cast<std::size_t>(e.body);
+      const Pose& X = data.X_WB[ub];
+      const Matrix3 R = X.rotation * data.aligned[ub].alignment;
+      const Vector3 moment = e.moment_W + (e.point_W - X.translation).cross(e.force_W);
+      data.f_J[ub].head<3>() -= R.transpose() * e.force_W;
+      data.f_J[ub].tail<3>() -= R.transpose() * moment;
+    }
+  }
+  // Backward: the subtree's wrench, carried in registers along a chain.
+  Vec F_child{0.0, 0.0, 0.0};
+  Vec N_child{0.0, 0.0, 0.0};
+  for (int i = nb - 1; i > 0; --i) {
+    const auto ui = static_cast<std::size_t>(i);
+    const int p = model.parents[ui];
+    const bool chain_child = i + 1 < nb && model.parents[ui + 1] == i;
+    Vec F = load(data.f_J[ui], 0);
+    Vec N = load(data.f_J[ui], 3);
+    if (chain_child) {
+      F = F + F_child;
+      N = N + N_child;
+    }
+    const Data::AlignedBody& b = data.aligned[ui];
+    const double r = b.revolute;
+    data.tau[i - 1] = r * N.z + (1.0 - r) * F.z;
+    // Into J_p, about its origin.
+    const double c = data.cos_q[i - 1];
+    const double s = data.sin_q[i - 1];
+    const Vec t = load(b.translation) + q[i - 1] * load(b.slide);
+    const Vec F_p = times(b.rotation, rotate_z(c, s, F));
+    const Vec N_p = times(b.rotation, rotate_z(c, s, N)) + cross(t, F_p);
+    if (p == i - 1) {
+      F_child = F_p;
+      N_child = N_p;
+    } else {
+      Vector6& f_p = data.f_J[static_cast<std::size_t>(p)];
+      store(load(f_p, 0) + F_p, f_p, 0);
+      store(load(f_p, 3) + N_p, f_p, 3);
+      F_child = {0.0, 0.0, 0.0};
+      N_child = {0.0, 0.0, 0.0};
+    }
+  }
+  Vector6 f0 = data.f_J[0];
+  if (nb > 1 && model.parents[1] == 0) {
+    store(load(f0, 0) + F_child, f0, 0);
+    store(load(f0, 3) + N_child, f0, 3);
+  }
+  data.root_wrench_W = f0;                           // J_0 is the world frame
   detail::add_armature_times(model, ddq, data.tau);  // the rotors: not in the base wrench
   return data.tau;
 }
@@ -189,7 +294,7 @@ const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<
   // registers.
   const int nb = model.num_bodies();
   // Not detail::joint_sin_cos: glibc's sincos was a third of this pass (sin_cos_poly).
-  for (int j = 0; j < nb - 1; ++j) detail::sin_cos_poly(q[j], data.sin_q[j], data.cos_q[j]);
+  detail::sin_cos_poly_n(q.data(), data.sin_q.data(), data.cos_q.data(), nb - 1);
   Vector3 g = model.gravity;  // body 0 is the world frame
   data.gravity_B[0] = g;
   {

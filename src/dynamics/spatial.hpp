@@ -95,24 +95,17 @@ inline void sin_cos(double angle, double& s, double& c) {
 #endif
 }
 
-/// sin and cos of one angle without a libm call, within 2.3e-16 of glibc's (2 ulp over 10^7
-/// random angles up to 10^6 rad): the nearest multiple k of pi/2 is removed in three parts
-/// (Cody-Waite; each k * part exact for |k| < 2^26), Cephes' minimax polynomials on
-/// [-pi/4, pi/4], the quadrant from k mod 4. |angle| > 2^20 rad, inf and NaN go to sin_cos.
-/// ~6 ns against ~11 ns for glibc's sincos here; gravity_torques and crba use it (the libm calls
-/// were a third of the gravity pass). The other passes keep sin_cos:
-/// their results stay bit for bit.
-inline void sin_cos_poly(double angle, double& s, double& c) {
-  if (!(std::abs(angle) <= 1048576.0)) {
-    sin_cos(angle, s, c);
-    return;
-  }
+namespace sin_cos_detail {
+constexpr double kLargest = 1048576.0;              // 2^20: beyond, the reduction below loses bits
+constexpr double kRoundShift = 6755399441055744.0;  // 1.5 * 2^52: x + it - it rounds x
+
+/// The nearest multiple k of pi/2 and sin, cos of the rest r = angle - k pi/2 in [-pi/4, pi/4].
+[[gnu::always_inline]] inline void reduced(double angle, double& k, double& sin_r, double& cos_r) {
   constexpr double kTwoOverPi = 0.636619772367581343075535053490057448;
-  constexpr double kRoundShift = 6755399441055744.0;   // 1.5 * 2^52: x + it - it rounds x
   constexpr double kHalfPi1 = 1.57079625129699707031;  // pi/2 = kHalfPi1 + kHalfPi2 + kHalfPi3
   constexpr double kHalfPi2 = 7.54978941586159635335e-8;
   constexpr double kHalfPi3 = 5.39030285815811905290e-15;
-  const double k = (angle * kTwoOverPi + kRoundShift) - kRoundShift;
+  k = (angle * kTwoOverPi + kRoundShift) - kRoundShift;
   const double r = ((angle - k * kHalfPi1) - k * kHalfPi2) - k * kHalfPi3;
   // Cephes' sin.c coefficients, highest power first.
   constexpr double kSin[6] = {1.58962301576546568060e-10, -2.50507477628578072866e-8,
@@ -128,8 +121,26 @@ inline void sin_cos_poly(double angle, double& s, double& c) {
     ps = ps * z + kSin[i];
     pc = pc * z + kCos[i];
   }
-  const double sin_r = r + r * z * ps;
-  const double cos_r = 1.0 - 0.5 * z + z * z * pc;
+  sin_r = r + r * z * ps;
+  cos_r = 1.0 - 0.5 * z + z * z * pc;
+}
+}  // namespace sin_cos_detail
+
+/// sin and cos of one angle without a libm call, within 2.3e-16 of glibc's (2 ulp over 10^7
+/// random angles up to 10^6 rad): the nearest multiple k of pi/2 is removed in three parts
+/// (Cody-Waite; each k * part exact for |k| < 2^26), Cephes' minimax polynomials on
+/// [-pi/4, pi/4], the quadrant from k mod 4. |angle| > 2^20 rad, inf and NaN go to sin_cos.
+/// ~6 ns against ~11 ns for glibc's sincos here; gravity_torques, crba and rnea use it (the libm
+/// calls were a third of the gravity pass). The other passes keep sin_cos: their results stay
+/// bit for bit.
+
+inline void sin_cos_poly(double angle, double& s, double& c) {
+  if (!(std::abs(angle) <= sin_cos_detail::kLargest)) {
+    sin_cos(angle, s, c);
+    return;
+  }
+  double k, sin_r, cos_r;
+  sin_cos_detail::reduced(angle, k, sin_r, cos_r);
   // angle = k pi/2 + r: quadrant j = k mod 4 (two's complement: also for negative k). Selected
   // with bit masks, not branches: the quadrant of arbitrary joint angles is unpredictable, and
   // GCC compiled the ?: selections to jumps. Same values (negation = flipping the sign bit).
@@ -141,6 +152,32 @@ inline void sin_cos_poly(double angle, double& s, double& c) {
   const std::uint64_t c1 = (bc & ~swap) | (bs & swap);
   s = std::bit_cast<double>(s1 ^ ((j & 2) << 62));
   c = std::bit_cast<double>(c1 ^ (((j + 1) & 2) << 62));
+}
+
+/// sin_cos_poly of n angles at once: the quadrant selected by arithmetic on 0/1 factors
+/// (exact) instead of integer bit masks, so that the compiler runs two angles per SSE2
+/// instruction. Same values as sin_cos_poly (a zero's sign aside). Any angle beyond 2^20 rad,
+/// inf or NaN: every one goes through sin_cos_poly.
+inline void sin_cos_poly_n(const double* angle, double* s, double* c, int n) {
+  bool in_range = true;
+  for (int j = 0; j < n; ++j) in_range &= std::abs(angle[j]) <= sin_cos_detail::kLargest;
+  if (!in_range) {
+    for (int j = 0; j < n; ++j) sin_cos_poly(angle[j], s[j], c[j]);
+    return;
+  }
+  constexpr double kShift = sin_cos_detail::kRoundShift;
+  for (int j = 0; j < n; ++j) {
+    double k, sin_r, cos_r;
+    sin_cos_detail::reduced(angle[j], k, sin_r, cos_r);
+    // k mod 4 = k - 4 floor(k / 4); floor(k / 4) rounds k / 4 - 3/8 (k / 4 is a multiple of 1/4,
+    // never a tie); then odd = quadrant mod 2 and half = quadrant >= 2 the same way.
+    const double quadrant = k - 4.0 * (((k * 0.25 - 0.375) + kShift) - kShift);
+    const double half = ((quadrant * 0.5 - 0.25) + kShift) - kShift;
+    const double odd = quadrant - 2.0 * half;
+    const double negate_cos = half + odd - 2.0 * half * odd;  // quadrants 1 and 2
+    s[j] = ((1.0 - odd) * sin_r + odd * cos_r) * (1.0 - 2.0 * half);
+    c[j] = ((1.0 - odd) * cos_r + odd * sin_r) * (1.0 - 2.0 * negate_cos);
+  }
 }
 
 /// Rotation by the angle of sine s and cosine c about the unit `axis` (Rodrigues).

@@ -32,5 +32,16 @@ TEST(Data, DoesNotMatchAModelOfTheSameSizeWithOtherJoints) {
   EXPECT_FALSE(Data(model).matches(prismatic));
 }
 
+// rnea reads the mass properties Data cached in each joint-aligned frame.
+TEST(Data, DoesNotMatchAModelOfTheSameSizeWithOtherInertias) {
+  const Model model = random_chain({.n = 6});
+  Model heavier = model;
+  heavier.bodies[4].inertia.mass *= 1.5;
+  EXPECT_FALSE(Data(model).matches(heavier));
+  Model shifted = model;
+  shifted.bodies[2].inertia.com.x() += 0.01;
+  EXPECT_FALSE(Data(model).matches(shifted));
+}
+
 }  // namespace
 }  // namespace extwrench

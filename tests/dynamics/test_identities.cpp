@@ -150,26 +150,52 @@ TEST_P(DynamicsIdentities, GravityPassEqualsRneaAtRestAndTheBiasPass) {
   }
 }
 
-// The pass's own sin/cos (no libm call below 2^20 rad) in every quadrant, at its seams
-// (multiples of pi/4), far out, and past 2^20 rad where it falls back to libm.
+// Angles that exercise the passes' own sin/cos (no libm call below 2^20 rad): every quadrant,
+// its seams (multiples of pi/4), far out, and past 2^20 rad where it falls back to libm.
+VectorX large_angle_state(const Model& model, SeededRng& rng, int k) {
+  const int n = model.nq();
+  VectorX q = rng.uniform_vector(n, -1e4, 1e4);
+  if (k % 4 == 1) {
+    for (int i = 0; i < n; ++i) q[i] = (k / 4 % 17 - 8 + i) * (std::numbers::pi / 4);
+  } else if (k % 4 == 2) {
+    q = rng.uniform_vector(n, -3e6, 3e6);
+  }
+  // Angles only: a prismatic joint stays within a metre (kilometres of lever arm would test
+  // cancellation in the torques, not the sines).
+  for (int i = 0; i < n; ++i) {
+    if (model.joints[i + 1].type == JointType::kPrismatic) q[i] = std::remainder(q[i], 1.0);
+  }
+  return q;
+}
+
 TEST_P(DynamicsIdentities, GravityPassHoldsAtLargeAnglesAndQuadrantSeams) {
   Data data(model_);
   Data other(model_);
   SeededRng rng(25);
+  for (int k = 0; k < kStates; ++k) {
+    const VectorX q = large_angle_state(model_, rng, k);
+    EXPECT_LE(gravity_error_against_bias_pass(model_, data, other, q), kGravityTol) << k;
+  }
+}
+
+// rnea (joint-aligned body frames, its own sin/cos) and crba (fused, its own sin/cos) against
+// the world-frame two-step paths after forward_kinematics (glibc's sincos).
+TEST_P(DynamicsIdentities, RneaAndCrbaHoldAtLargeAnglesAndQuadrantSeams) {
+  Data data(model_);
+  Data other(model_);
+  SeededRng rng(27);
   const int n = model_.nq();
   for (int k = 0; k < kStates; ++k) {
-    VectorX q = rng.uniform_vector(n, -1e4, 1e4);
-    if (k % 4 == 1) {
-      for (int i = 0; i < n; ++i) q[i] = (k / 4 % 17 - 8 + i) * (std::numbers::pi / 4);
-    } else if (k % 4 == 2) {
-      q = rng.uniform_vector(n, -3e6, 3e6);
-    }
-    // Angles only: a prismatic joint stays within a metre (kilometres of lever arm would test
-    // cancellation in the torques, not the sines).
-    for (int i = 0; i < n; ++i) {
-      if (model_.joints[i + 1].type == JointType::kPrismatic) q[i] = std::remainder(q[i], 1.0);
-    }
-    EXPECT_LE(gravity_error_against_bias_pass(model_, data, other, q), kGravityTol) << k;
+    const VectorX q = large_angle_state(model_, rng, k);
+    const VectorX dq = rng.uniform_vector(n, -2, 2), ddq = rng.uniform_vector(n, -5, 5);
+    const VectorX tau = rnea(model_, data, q, dq, ddq);
+    const Vector6 root = data.root_wrench_W;
+    const MatrixX m = crba(model_, data, q);
+    forward_kinematics(model_, other, q);
+    const VectorX tau_ref = rnea_no_kinematics(model_, other, dq, ddq);
+    EXPECT_LE(test::relative_error(tau, tau_ref), 1e-12) << k;
+    EXPECT_LE(test::relative_error(root, other.root_wrench_W), 1e-12) << k;
+    EXPECT_LE(test::relative_error(m, crba_no_kinematics(model_, other)), 1e-12) << k;
   }
 }
 
@@ -285,6 +311,7 @@ TEST_P(DynamicsIdentities, ExternalWrenchEntersAsJacobianTranspose) {
     const VectorX q = rng.uniform_vector(n, -3, 3), dq = rng.uniform_vector(n, -2, 2);
     const VectorX ddq = rng.uniform_vector(n, -5, 5);
     const VectorX tau_free = rnea(model_, data, q, dq, ddq);
+    forward_poses(model_, data, q);
     ExternalWrench w;
     w.body = 1 + k % n;
     w.force_W = rng.uniform_vector3(-20, 20);
@@ -406,10 +433,13 @@ TEST_P(DynamicsIdentities, StaticRobotDischargesItsWeightAndItsMoment) {
   SeededRng rng(20);
   const int n = model_.nq();
   const VectorX zero = VectorX::Zero(n);
+  const Vector3 p_WS(0.1, -0.2, -0.3);
   for (int k = 0; k < kStates; ++k) {
     const VectorX q = rng.uniform_vector(n, -3, 3);
     rnea(model_, data, q, zero, zero);
-    // Independent centre of mass: from the model's inertias and the body poses.
+    const Vector6 reading = sensor_reading_world(data, p_WS);
+    // Independent centre of mass: from the model's inertias and the body poses (rnea forms none).
+    forward_poses(model_, data, q);
     double m = 0;
     Vector3 mc = Vector3::Zero();
     for (int i = 0; i <= n; ++i) {
@@ -417,8 +447,6 @@ TEST_P(DynamicsIdentities, StaticRobotDischargesItsWeightAndItsMoment) {
       m += in.mass;
       mc += in.mass * data.X_WB[i].act(in.com);
     }
-    const Vector3 p_WS(0.1, -0.2, -0.3);
-    const Vector6 reading = sensor_reading_world(data, p_WS);
     const Vector3 weight = m * model_.gravity;
     EXPECT_LE((reading.head<3>() - weight).norm(), 1e-12 * weight.norm());
     EXPECT_LE((reading.tail<3>() - (mc / m - p_WS).cross(weight)).norm(), 1e-12 * weight.norm());

@@ -213,7 +213,9 @@ void MjcfReference::run(bool with_wrenches, unsigned seed) {
       EXPECT_LE(test::relative_error(reading, sensed), kTol)
           << "state " << k << "\nours " << reading.transpose() << "\nmj   " << sensed.transpose();
     }
-    // Every MuJoCo body and site of the robot where ours is (mj_inverse ran mj_kinematics).
+    // Every MuJoCo body and site of the robot where ours is (mj_inverse ran mj_kinematics; rnea
+    // forms no pose).
+    forward_poses(model, data, q);
     for (std::size_t f = 0; f < model.frames.size(); ++f) {
       const char* name = model.frames[f].name.c_str();
       const int b = mj_name2id(m, mjOBJ_BODY, name), s = mj_name2id(m, mjOBJ_SITE, name);

@@ -15,10 +15,10 @@ namespace extwrench {
 struct Data {
   explicit Data(const Model& model);
 
-  /// True if this Data was sized for `model` and its cached joint terms (rotation_const,
-  /// rotation_cos, rotation_sin and their transposes, axis_P, S_B, slide_P) are those of model's
-  /// joints: a Data built for one Model is not valid for another of the same size whose joint axes
-  /// or placements differ.
+  /// True if this Data was sized for `model` and its cached terms (rotation_const, rotation_cos,
+  /// rotation_sin and their transposes, axis_P, S_B, slide_P, aligned) are those of model's joints
+  /// and bodies: a Data built for one Model is not valid for another of the same size whose joint
+  /// axes, placements or inertias differ.
   [[nodiscard]] bool matches(const Model& model) const;
 
   // --- derived from the model once, for the hot path ---
@@ -38,6 +38,31 @@ struct Data {
   /// The parent-frame translation of joint i per unit of q: P_i a for a prismatic joint, zero for
   /// a revolute one, so body i's origin in its parent is placement + slide_P q for every joint.
   std::vector<Vector3> slide_P;
+
+  /// rnea's frames: body i's own frame turned so that its joint axis is +z, J_i = B_i A_i with a
+  /// constant rotation A_i (A_i e_z = the axis; A_i = 1 when the axis is +z). In them the joint's
+  /// rotation is AlignedBody::rotation · Rz(q), formed from two columns, and the motion subspace is
+  /// e_z: the recursion's joint terms are a few scalars (docs/algorithms.md, "Inverse dynamics").
+  /// Derived from the Model once, mass properties included: build a new Data after changing a
+  /// body's inertia (the other algorithms read the Model's).
+  struct AlignedBody {
+    Matrix3 rotation = Matrix3::Identity();  ///< A_pᵀ P_i A_i: E'_i(q) = rotation · Rz(q)
+    /// Its transpose: E'_i(q)ᵀ x as a combination of columns (no horizontal sums).
+    Matrix3 rotation_T = Matrix3::Identity();
+    Vector3 translation = Vector3::Zero();  ///< A_pᵀ t_i: the joint's origin in J_p at q = 0
+    Vector3 slide = Vector3::Zero();  ///< A_pᵀ P_i a per unit of q (prismatic), zero (revolute)
+    double revolute = 1.0;            ///< 1 revolute, 0 prismatic
+    Matrix3 alignment = Matrix3::Identity();  ///< A_i
+    double mass = 0.0;                        ///< m_i
+    Vector3 first_moment = Vector3::Zero();   ///< m_i c_i in J_i
+    Matrix3 inertia_O = Matrix3::Zero();      ///< rotational inertia about J_i's origin, in J_i
+    bool operator==(const AlignedBody&) const = default;
+  };
+  std::vector<AlignedBody> aligned;
+  /// Scratch of rnea, in each body's J_i: its angular velocity w, [a; w_dot] (a the classical
+  /// acceleration of J_i's origin) and the wrench [F; N] its joint transmits (about that origin).
+  std::vector<Vector3> w_J;
+  std::vector<Vector6> a_J, f_J;
 
   // --- forward kinematics (forward_kinematics) ---
   std::vector<Pose> X_WB;  ///< pose of each body frame in the world

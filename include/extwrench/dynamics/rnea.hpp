@@ -19,11 +19,11 @@ struct ExternalWrench {
 
 /// Inverse dynamics tau = B(q) ddq + C(q, dq) dq + g(q) - sum_k J_k^T W_k, eqs. (7)-(12),
 /// iterated down to link 0: data.root_wrench_W is f_0 (the wrench the ground applies to link 0,
-/// about the world origin, link 0's own weight included). Computes the poses data.X_WB and
-/// data.S of forward_kinematics (with data.v, data.a, data.f), but not its world mass properties
-/// (data.mass, first_moment_W, inertia_O_W): the Newton-Euler step uses the body-axes inertia
-/// about the CoM instead. Run forward_kinematics before any *_no_kinematics algorithm.
-/// q, dq, ddq: (n). Returns data.tau.
+/// about the world origin, link 0's own weight included). Works in each body's joint-aligned
+/// frame (Data::aligned, its mass properties cached there) and forms no world pose: it leaves
+/// data.tau, data.root_wrench_W and its scratch (data.w_J, a_J, f_J), not data.X_WB, S, v, a, f
+/// (run forward_poses or forward_kinematics for those; with external wrenches it runs
+/// forward_poses itself, to bring them into the body frames). q, dq, ddq: (n). Returns data.tau.
 const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& ddq,
                     std::span<const ExternalWrench> external = {});
