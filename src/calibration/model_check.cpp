@@ -20,6 +20,45 @@ constexpr double kOffsetSpreads = 2.0;
 constexpr double kSuggestedCutoff = 20.0;  // [Hz]
 constexpr double kHighFrequencyLeft = 0.3;
 
+/// y ≈ c + a x1 + b x2 by least squares over the used samples: b, and the share of y's variance
+/// that x2 explains beyond x1 (R² of both minus R² of x1 alone).
+struct SecondRegressor {
+  double slope = 0.0, extra_r2 = 0.0;
+};
+SecondRegressor fit_beyond(const std::vector<double>& y, const std::vector<double>& x1,
+                           const std::vector<double>& x2, const std::vector<char>& use) {
+  double n = 0, m1 = 0, m2 = 0, my = 0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    if (!use[k]) continue;
+    n += 1;
+    m1 += x1[k];
+    m2 += x2[k];
+    my += y[k];
+  }
+  SecondRegressor out;
+  if (n < 4) return out;
+  m1 /= n;
+  m2 /= n;
+  my /= n;
+  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();
+  double yy = 0.0;
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    if (!use[k]) continue;
+    const Eigen::Vector2d x(x1[k] - m1, x2[k] - m2);
+    A += x * x.transpose();
+    b += x * (y[k] - my);
+    yy += (y[k] - my) * (y[k] - my);
+  }
+  if (yy <= 1e-300 || A(1, 1) <= 1e-300) return out;
+  const double r2_first = A(0, 0) > 1e-300 ? b[0] * b[0] / (A(0, 0) * yy) : 0.0;
+  const Eigen::Vector2d coef =
+      (A + 1e-12 * A.trace() * Eigen::Matrix2d::Identity()).ldlt().solve(b);
+  out.slope = coef[1];
+  out.extra_r2 = std::max(coef.dot(b) / yy - r2_first, 0.0);
+  return out;
+}
+
 /// Variance of x over the used samples.
 double variance(const std::vector<double>& x, const std::vector<char>& use) {
   double n = 0.0, sum = 0.0, sum2 = 0.0;
@@ -48,7 +87,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
   const std::size_t n = series.size();
   const std::vector<double> suggested = residual_filter_weights(samples, kSuggestedCutoff);
   check.joint_rms = VectorX::Zero(static_cast<Eigen::Index>(n));
-  std::vector<double> phi, z;
+  std::vector<double> phi, z, acc, z_acc;
   for (std::size_t i = 0; i < n; ++i) {
     const JointSeries& s = series[i];
     const int joint = static_cast<int>(i) + 1;
@@ -82,6 +121,29 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
                                     num(100.0 * g.slope) + " % of it, R^2 " + num(g.r2) +
                                     "): a gravity / mass error in the model (a payload? --payload, "
                                     "with a base sensor)"});
+    }
+    // Follows q̈: the calibrated residual against the filtered acceleration (central differences
+    // of q̇). r = −δI q̈ when the robot's inertia along the joint exceeds the model's by δI (a
+    // rotor inertia the model lacks; B's diagonal, so not a pure g(q) or friction pattern).
+    acc.assign(s.dq.size(), 0.0);
+    for (std::size_t k = 1; k + 1 < s.dq.size(); ++k)
+      acc[k] = (s.dq[k + 1] - s.dq[k - 1]) / (samples[k + 1].t - samples[k - 1].t);
+    // Beyond g(q): in a periodic motion the position, hence a gravity error, follows q̈ too.
+    filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
+    const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
+    if (inertia.extra_r2 >= kJointShare) {
+      const double delta = -inertia.slope;
+      check.patterns.push_back(
+          {"inertia", joint, inertia.extra_r2,
+           "joint " + std::to_string(joint) +
+               ": the calibrated residual follows the joint's acceleration (R^2 " +
+               num(inertia.extra_r2) + " beyond g(q)): the robot's inertia along it is " +
+               num(std::abs(delta)) + " kg m^2 " + (delta > 0 ? "larger" : "smaller") +
+               " than the model's (" +
+               (delta > 0 ? "a rotor inertia the model lacks: armature: in the configuration"
+                          : "the model's link inertias are too large, or the torque lags the "
+                            "velocity") +
+               ")"});
     }
     // Mostly above ~20 Hz (unfiltered joints only): the velocity's noise through K B(q), or the
     // torque's, which the residual filter removes (docs/estimator.md#residual-filter).

@@ -373,6 +373,33 @@ TEST(ModelCheckSim, NamesAMassErrorThroughGravityAndTheBaseForce) {
   EXPECT_FALSE(has(k, "sensor_pose"));  // the joints say it is a mass, not the sensor
 }
 
+// A rotor inertia (armature) on joints 1 and 4 that the model lacks: the residual follows their
+// acceleration, −δI q̈, and the check names both with δI's size and sign. In a motion of one
+// sine per joint q̈ follows q, and so would a gravity error: only what q̈ explains beyond g(q)
+// counts, so a rotor on joint 2 (whose g(q) follows q2) would go unnamed in this motion.
+TEST(ModelCheckSim, NamesARotorInertiaTheModelLacks) {
+  const Model model = paper_arm();
+  Model with_rotors = model;
+  with_rotors.joints[1].armature = 0.4;
+  with_rotors.joints[4].armature = 0.3;
+  const auto log =
+      test::simulate_free_motion(with_rotors, test::free_motion(0.0, 1.0),
+                                 test::paper_arm_friction(), 20.0, Vector6::Zero(), kTauNoise, 59);
+  const Calibration cal = calibrate(model, ft_options(), log);
+  (void)kinds(cal);
+  const double truth[8] = {0, 0.4, 0, 0, 0.3, 0, 0, 0};
+  std::vector<int> named;
+  for (const ModelPattern& p : cal.model_check.patterns) {
+    if (p.kind != "inertia") continue;
+    named.push_back(p.joint);
+    // The size printed: within 20 % of the armature.
+    const std::string size = p.message.substr(p.message.find("is ") + 3);
+    EXPECT_NEAR(std::stod(size), truth[p.joint], 0.2 * truth[p.joint]) << p.message;
+    EXPECT_NE(p.message.find("larger"), std::string::npos) << p.message;
+  }
+  EXPECT_EQ(named, (std::vector<int>{1, 4}));
+}
+
 TEST(ModelCheckSim, NamesASensorOrientationError) {
   const Model model = paper_arm();
   Pose tilted;

@@ -88,7 +88,8 @@ struct JointFitReport {
 
 /// A recognisable error of the model named by the model check (docs/calibration.md#model-check).
 struct ModelPattern {
-  std::string kind;    ///< base_force_offset | gravity | coulomb | sensor_pose | high_frequency
+  /// base_force_offset | gravity | coulomb | inertia | sensor_pose | high_frequency
+  std::string kind;
   int joint = 0;       ///< 1-based joint, 0 for the base sensor
   double share = 0.0;  ///< R² of the pattern's regression, or offset / spread
   std::string message;
