@@ -72,7 +72,7 @@ struct Data {
   std::vector<Vector3> first_moment_W;  ///< h_i = m_i c_i (world)
   std::vector<Matrix3> inertia_O_W;     ///< rotational inertia about the world origin
 
-  // --- velocities / accelerations / forces (rnea & co.) ---
+  // --- velocities / accelerations / forces (rnea_no_kinematics & co.; rnea uses w_J, a_J, f_J) ---
   std::vector<Vector6> v;       ///< spatial velocity of body i
   std::vector<Vector6> a;       ///< spatial acceleration of body i (gravity trick included)
   std::vector<Vector6> f;       ///< spatial force transmitted by joint i to body i (f_i)
