@@ -51,10 +51,6 @@ const VectorX& backward_pass(const Model& model, Data& data,
   return data.tau;
 }
 
-}  // namespace
-
-namespace {
-
 // rnea's 3-vectors as three doubles: Eigen's Vector3 arithmetic under SSE2 mixes 2-double
 // packets with scalars, and rebuilt packets from scalars through the stack, each one a
 // store-forwarding stall (they were most of rnea's time in `perf annotate`).
@@ -83,21 +79,20 @@ struct Vec {
 [[gnu::always_inline]] inline Vec rotate_z_inverse(double c, double s, const Vec& x) {
   return {c * x.x + s * x.y, c * x.y - s * x.x, x.z};
 }
-[[gnu::always_inline]] inline Vec load(const Vector6& v, int offset) {
+/// Three consecutive coefficients of an Eigen vector (Vector3 or Vector6) from `offset`.
+template <typename V>
+[[gnu::always_inline]] inline Vec load(const V& v, int offset = 0) {
   return {v[offset], v[offset + 1], v[offset + 2]};
 }
-[[gnu::always_inline]] inline void store(const Vec& x, Vector3& v, int offset) {
+template <typename V>
+[[gnu::always_inline]] inline void store(const Vec& x, V& v, int offset) {
   v[offset] = x.x;
   v[offset + 1] = x.y;
   v[offset + 2] = x.z;
 }
-[[gnu::always_inline]] inline Vec load(const Vector3& v, int offset = 0) {
-  return {v[offset], v[offset + 1], v[offset + 2]};
-}
-[[gnu::always_inline]] inline void store(const Vec& x, Vector6& v, int offset) {
-  v[offset] = x.x;
-  v[offset + 1] = x.y;
-  v[offset + 2] = x.z;
+/// Joint i's origin in its parent's aligned frame: t'_i + slide'_i q_i.
+[[gnu::always_inline]] inline Vec joint_origin(const Data::AlignedBody& b, double qi) {
+  return load(b.translation) + qi * load(b.slide);
 }
 
 }  // namespace
@@ -146,7 +141,7 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
     const double qd = dq[i - 1];
     const double qdd = ddq[i - 1];
     const double r = b.revolute;
-    const Vec t = load(b.translation) + q[i - 1] * load(b.slide);
+    const Vec t = joint_origin(b, q[i - 1]);
     // The acceleration of this joint's origin as a point of the parent, then all into J_i.
     a = rotate_z_inverse(c, s, times(b.rotation_T, a + cross(w_dot, t) + cross(w, cross(w, t))));
     w = rotate_z_inverse(c, s, times(b.rotation_T, w));
@@ -202,7 +197,7 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
     // Into J_p, about its origin.
     const double c = data.cos_q[i - 1];
     const double s = data.sin_q[i - 1];
-    const Vec t = load(b.translation) + q[i - 1] * load(b.slide);
+    const Vec t = joint_origin(b, q[i - 1]);
     const Vec F_p = times(b.rotation, rotate_z(c, s, F));
     const Vec N_p = times(b.rotation, rotate_z(c, s, N)) + cross(t, F_p);
     if (p == i - 1) {
