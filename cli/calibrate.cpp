@@ -28,6 +28,7 @@ struct CalibrateOptions {
   std::string thresholds = "auto";
   bool payload = false;
   bool known_torque = false;
+  bool inertia = false;
   std::vector<std::filesystem::path> package_path;
 };
 
@@ -72,6 +73,12 @@ void print_report(const Calibration& c, const HoldoutReport* h, bool in_contact)
     for (Eigen::Index i = 0; i < c.residual_cutoff.size(); ++i)
       std::cout << " " << cell(c.residual_cutoff[i], 0);
     std::cout << " (RMS, noise and thresholds are of the filtered residual)\n";
+  }
+  if (c.inertia_correction.size() > 0 && !c.inertia_correction.isZero(0.0)) {
+    std::cout << "  inertia correction [kg m^2] (p = B(q) dq + dI dq):";
+    for (Eigen::Index i = 0; i < c.inertia_correction.size(); ++i)
+      std::cout << " " << cell(c.inertia_correction[i], 0);
+    std::cout << "\n";
   }
   if (c.sensor_type != SensorType::kNone) {
     std::cout << "  sensor bias [f; n] (S): " << cells(Vector3(c.sensor_bias_S.head<3>())) << " N, "
@@ -156,6 +163,7 @@ void run_calibrate(const CalibrateOptions& opt) {
   co.smoothing_velocity = opt.smoothing_velocity;
   co.payload = opt.payload;
   co.known_external_torque = opt.known_torque;
+  co.inertia_correction = opt.inertia;
   co.false_alarms_per_hour = opt.false_alarms_per_hour;
   if (opt.thresholds == "auto") {
     co.thresholds = ThresholdModel::kAuto;
@@ -240,6 +248,10 @@ void register_calibrate(CLI::App& app) {
                 "torque known during the recording (e.g. J_v^T F of a force plate under the "
                 "contact): it is taken out of the residual before the fit (needs sensor.type: "
                 "none)");
+  sub->add_flag("--inertia", opt->inertia,
+                "Also fit a correction of the inertia along each joint (observer.inertia_"
+                "correction), kept where it lowers the joint's residual by 10 % or more beyond a "
+                "gravity error; best with observer.residual_cutoff on noisy joints");
   add_package_path_option(*sub, opt->package_path);
   sub->callback([opt]() { run_calibrate(*opt); });
 }

@@ -1,6 +1,7 @@
 #include "extwrench/calibration/calibration.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -84,6 +85,7 @@ void run_observer(const Model& model, const VectorX& gains, const JointFriction&
     if (!residual_only) {
       s.dq.assign(N, 0.0);
       s.alpha.assign(N, 0.0);
+      s.dt.assign(N, 0.0);
     }
   }
   const Sample& first = samples.front();
@@ -98,7 +100,8 @@ void run_observer(const Model& model, const VectorX& gains, const JointFriction&
       js.r0[k] = observer.residual()[i];
       if (residual_only) continue;
       js.dq[k] = s.dq[i];
-      js.alpha[k] = k > 0 ? std::exp(-observer.gains()[i] * (s.t - samples[k - 1].t)) : 0.0;
+      js.dt[k] = k > 0 ? s.t - samples[k - 1].t : 0.0;
+      js.alpha[k] = k > 0 ? std::exp(-observer.gains()[i] * js.dt[k]) : 0.0;
     }
   }
 }
@@ -334,6 +337,41 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
   }
 }
 
+// g_i(q_k) along the log (the model check's gravity pattern), and the gravity torques of a unit
+// mass at the last link's origin and of unit first moments along its axes (a payload's, linear
+// in m and m c): with g_i, the nuisance regressors that keep the inertia fit from taking a
+// gravity error for an inertia (fit_joint).
+void gravity_series(const Model& model, const std::vector<Sample>& samples,
+                    std::vector<JointSeries>& series) {
+  const int n = model.nq();
+  const std::size_t N = samples.size();
+  std::array<Model, 5> models{model, model, model, model, model};
+  for (std::size_t c = 1; c < 5; ++c) {
+    Inertia unit;
+    unit.mass = 1.0;
+    if (c > 1) unit.com = Vector3::Unit(static_cast<Eigen::Index>(c - 2));
+    auto& body = models[c].bodies[static_cast<std::size_t>(n)].inertia;
+    body = body + unit;
+  }
+  for (JointSeries& js : series) {
+    js.gravity.assign(N, 0.0);
+    for (std::vector<double>& p : js.payload_gravity) p.assign(N, 0.0);
+  }
+  std::array<VectorX, 5> g;
+  std::vector<Data> data;  // one per model: Data caches its model's mass properties
+  data.reserve(5);
+  for (const Model& mc : models) data.emplace_back(mc);
+  for (std::size_t k = 0; k < N; ++k) {
+    for (std::size_t c = 0; c < 5; ++c) g[c] = gravity_torques(models[c], data[c], samples[k].q);
+    for (int i = 0; i < n; ++i) {
+      JointSeries& js = series[static_cast<std::size_t>(i)];
+      js.gravity[k] = g[0][i];
+      js.payload_gravity[0][k] = g[1][i] - g[0][i];
+      for (std::size_t a = 1; a < 4; ++a) js.payload_gravity[a][k] = g[a + 1][i] - g[1][i];
+    }
+  }
+}
+
 // Marks the samples inside the windows (and one settle time after each) as unused.
 void exclude_windows(const std::vector<SuspectWindow>& windows, const std::vector<Sample>& samples,
                      double settle, std::vector<char>& use) {
@@ -359,6 +397,7 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
   cal.tau_threshold = VectorX::Zero(n);
   cal.residual_noise = VectorX::Zero(n);
   cal.tau_per_speed = VectorX::Zero(n);
+  cal.inertia_correction = VectorX::Zero(n);
   const double rate = o.false_alarms_per_hour / 3600.0 / n;
   for (int i = 0; i < n; ++i) {
     const JointFrictionFit& f = fits[static_cast<std::size_t>(i)];
@@ -367,9 +406,12 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
     cal.friction.offset[i] = f.offset;
     cal.friction.joint_smoothing[i] = f.smoothing;
     if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift[i] = f.shift;
+    cal.inertia_correction[i] = f.inertia;
     for (const std::string& w : f.warnings) cal.warnings.push_back(w);
     JointFitReport j;
     j.condition = f.condition;
+    j.inertia_correction = f.inertia;
+    j.inertia_gain = f.inertia_gain;
     JointFitReport b;
     joint_threshold(before[static_cast<std::size_t>(i)].r0, samples, use, rate, 1.0, b);
     j.rms_before = b.rms_after;
@@ -464,6 +506,7 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
       remove_known_torque(samples, static_cast<int>(i), series[i], before[i]);
   }
 
+  gravity_series(m, samples, series);
   cal.observer_gain = gains;
   cal.residual_cutoff = per_joint(options.residual_cutoff, n);
   // The residual filter: every series from here on is the filtered residual (r is linear in θ,
@@ -484,12 +527,19 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   cal.t_end = samples.back().t;
   const double check_smoothing = o.smoothing_velocity > 0 ? o.smoothing_velocity : 0.01;
   std::vector<JointFrictionFit> fits(static_cast<std::size_t>(n));
-  for (int pass = 0; pass < 2; ++pass) {
+  // Contacts are looked for in the residual of friction alone: an inertia correction could
+  // absorb a push's part that follows q̈. The final fit, on the samples kept, adds it.
+  CalibrationOptions friction_only = o;
+  friction_only.inertia_correction = false;
+  const auto fit_all = [&](const CalibrationOptions& fo) {
     for (int i = 0; i < n; ++i) {
       const auto& s = series[static_cast<std::size_t>(i)];
       calibration_detail::check_excitation(s, use, i + 1, check_smoothing);
-      fits[static_cast<std::size_t>(i)] = calibration_detail::fit_joint(s, use, o, i + 1);
+      fits[static_cast<std::size_t>(i)] = calibration_detail::fit_joint(s, use, fo, i + 1);
     }
+  };
+  for (int pass = 0; pass < 2; ++pass) {
+    fit_all(pass == 0 ? friction_only : o);
     if (pass == 1) break;
     // Short strong contacts, and long ones that the fit has partly absorbed (half the level,
     // ten times the duration).
@@ -498,7 +548,10 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
     for (const SuspectWindow& w :
          suspect_windows(fits, samples, use, 0.5 * o.contact_sigma, 10.0 * o.contact_min_duration))
       cal.suspect_windows.push_back(w);
-    if (cal.suspect_windows.empty()) break;
+    if (cal.suspect_windows.empty()) {
+      if (o.inertia_correction) fit_all(o);
+      break;
+    }
     exclude_windows(cal.suspect_windows, samples, settle, use);
     const auto left = static_cast<int>(std::count(use.begin(), use.end(), 1));
     std::string list;
@@ -519,17 +572,8 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   cal.samples_used = static_cast<int>(std::count(use.begin(), use.end(), 1));
   friction_and_thresholds(fits, series, before, samples, use, o, cal);
   warn_unexplained_torque(samples, use, cal);
-  {  // Model check: g(q) along the log for the gravity pattern.
-    Data data(m);
-    std::vector<std::vector<double>> gravity(static_cast<std::size_t>(n),
-                                             std::vector<double>(samples.size(), 0.0));
-    for (std::size_t k = 0; k < samples.size(); ++k) {
-      const VectorX& g = gravity_torques(m, data, samples[k].q);
-      for (int i = 0; i < n; ++i) gravity[static_cast<std::size_t>(i)][k] = g[i];
-    }
-    calibration_detail::check_joints(series, before, fits, gravity, samples, cal.residual_cutoff,
-                                     use, cal.model_check);
-  }
+  calibration_detail::check_joints(series, before, fits, samples, cal.residual_cutoff, use,
+                                   cal.model_check);
   if (options.sensor.type != SensorType::kNone)
     sensor_calibration(model, options, samples, use, o, cal);
   // A base moment linear in the configuration is a sensor pose error only when the joints do
@@ -569,6 +613,8 @@ EstimatorOptions apply_calibration(EstimatorOptions options, const Calibration& 
   options.friction = calibration.friction;
   if (calibration.residual_cutoff.size() > 0)  // the thresholds are for its output
     options.residual_cutoff = calibration.residual_cutoff;
+  if (calibration.inertia_correction.size() > 0)  // part of the residual the fit minimised
+    options.inertia_correction = calibration.inertia_correction;
   options.detection.tau_min = calibration.tau_threshold;
   options.detection.tau_per_speed = calibration.tau_per_speed;
   if (calibration.sensor_type != SensorType::kNone && calibration.force_threshold > 0) {

@@ -21,44 +21,69 @@ constexpr std::array kShiftGrid{-0.05, -0.04, -0.03, -0.02, -0.01, 0.0,
 constexpr double kMinPeakSpeed = 0.05;     // [rad/s]
 constexpr double kMinShareEachWay = 0.02;  // of the samples used
 constexpr double kMaxCondition = 1e4;      // of the column-scaled regression
+// The inertia correction is fitted where it lowers the residual's sum of squares by this share.
+constexpr double kMinInertiaGain = 0.1;
 
 std::string joint_name(int joint) { return "joint " + std::to_string(joint); }
 
-// Least squares of r⁰ + Z θ ≈ 0 over the used samples, with the columns in `active`.
+// Least squares of r⁰ + Z θ ≈ 0 over the used samples, with the C columns in `active`.
+template <int C>
 struct Solve {
-  Eigen::Vector3d theta = Eigen::Vector3d::Zero();
+  using Vec = Eigen::Matrix<double, C, 1>;
+  Vec theta = Vec::Zero();
   double rss = std::numeric_limits<double>::infinity();
   double condition = 1.0;
 };
 
-Solve solve(const std::array<const std::vector<double>*, 3>& z, const std::vector<double>& r0,
-            const std::vector<char>& use, const std::array<bool, 3>& active, double lambda) {
-  Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+template <int C>
+Solve<C> solve(const std::array<const std::vector<double>*, C>& z, const std::vector<double>& r0,
+               const std::vector<char>& use, const std::array<bool, C>& active, double lambda) {
+  using Mat = Eigen::Matrix<double, C, C>;
+  using Vec = Eigen::Matrix<double, C, 1>;
+  Mat G = Mat::Zero();
+  Vec b = Vec::Zero();
   double rr = 0.0;
   for (std::size_t k = 0; k < r0.size(); ++k) {
     if (!use[k]) continue;
-    const Eigen::Vector3d zk((*z[0])[k], (*z[1])[k], (*z[2])[k]);
+    Vec zk;
+    for (int c = 0; c < C; ++c) zk[c] = (*z[static_cast<std::size_t>(c)])[k];
     G.noalias() += zk * zk.transpose();
     b.noalias() -= zk * r0[k];
     rr += r0[k] * r0[k];
   }
-  Solve out;
-  Eigen::Vector3d scale = Eigen::Vector3d::Zero();
-  for (int c = 0; c < 3; ++c)
+  Solve<C> out;
+  Vec scale = Vec::Zero();
+  for (int c = 0; c < C; ++c)
     scale[c] = active[static_cast<std::size_t>(c)] && G(c, c) > 0 ? 1.0 / std::sqrt(G(c, c)) : 0.0;
-  Eigen::Matrix3d Gs = scale.asDiagonal() * G * scale.asDiagonal();
-  for (int c = 0; c < 3; ++c)
+  Mat Gs = scale.asDiagonal() * G * scale.asDiagonal();
+  for (int c = 0; c < C; ++c)
     if (scale[c] == 0.0) Gs(c, c) = 1.0;  // an inactive column: θ_c = 0
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(Gs);
-  const Eigen::Vector3d ev = eig.eigenvalues();
+  const Eigen::SelfAdjointEigenSolver<Mat> eig(Gs);
+  const Vec ev = eig.eigenvalues();
   out.condition = std::sqrt(std::max(ev.maxCoeff(), 0.0) / std::max(ev.minCoeff(), 1e-300));
-  Gs.diagonal().array() += lambda * Gs.trace() / 3.0;
-  const Eigen::Vector3d bs = scale.asDiagonal() * b;
+  Gs.diagonal().array() += lambda * Gs.trace() / C;
+  const Vec bs = scale.asDiagonal() * b;
   out.theta = scale.asDiagonal() * Gs.ldlt().solve(bs);
   // RSS = rᵀr + 2 θᵀ Zᵀr + θᵀ G θ with Zᵀr = −b.
   out.rss = rr - 2.0 * out.theta.dot(b) + out.theta.dot(G * out.theta);
   return out;
+}
+
+// The friction columns (D, F_c, o) and, with `inertia`, the inertia correction's: solved, a
+// negative friction coefficient dropped and the rest refitted (friction opposes motion).
+template <int C>
+Solve<C> solve_friction(const std::array<const std::vector<double>*, C>& z,
+                        const std::vector<double>& r0, const std::vector<char>& use,
+                        double lambda) {
+  std::array<bool, C> active;
+  active.fill(true);
+  Solve<C> sol = solve<C>(z, r0, use, active, lambda);
+  for (int c = 0; c < 2 && (sol.theta[0] < 0 || sol.theta[1] < 0); ++c) {
+    if (sol.theta[0] < 0) active[0] = false;
+    if (sol.theta[1] < 0) active[1] = false;
+    sol = solve<C>(z, r0, use, active, lambda);
+  }
+  return sol;
 }
 
 }  // namespace
@@ -96,6 +121,15 @@ void filter_regressor(const std::vector<double>& phi, const std::vector<double>&
   z.assign(phi.size(), 0.0);
   for (std::size_t k = 1; k < phi.size(); ++k)
     z[k] = alpha[k] * z[k - 1] + (1.0 - alpha[k]) * 0.5 * (phi[k - 1] + phi[k]);
+  apply_residual_filter(residual_filter_weight, z);
+}
+
+void filter_rate(const std::vector<double>& x, const std::vector<double>& alpha,
+                 const std::vector<double>& dt, std::vector<double>& z,
+                 const std::vector<double>& residual_filter_weight) {
+  z.assign(x.size(), 0.0);
+  for (std::size_t k = 1; k < x.size(); ++k)
+    z[k] = alpha[k] * z[k - 1] + (1.0 - alpha[k]) * (x[k] - x[k - 1]) / dt[k];
   apply_residual_filter(residual_filter_weight, z);
 }
 
@@ -143,33 +177,39 @@ void check_excitation(const JointSeries& s, const std::vector<char>& use, int jo
 JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                            const CalibrationOptions& options, int joint) {
   const std::size_t N = s.dq.size();
-  std::vector<double> ones(N, 1.0), z_viscous, z_offset, phi(N), z_coulomb;
+  std::vector<double> ones(N, 1.0), z_viscous, z_offset, phi(N), z_coulomb, z_inertia;
   filter_regressor(s.dq, s.alpha, z_viscous, s.filter_weight);
   filter_regressor(ones, s.alpha, z_offset, s.filter_weight);
+  const bool try_inertia = options.inertia_correction && !s.dt.empty();
+  if (try_inertia) filter_rate(s.dq, s.alpha, s.dt, z_inertia, s.filter_weight);
   std::vector<double> smoothings(kSmoothingGrid.begin(), kSmoothingGrid.end());
   if (options.smoothing_velocity > 0) smoothings = {options.smoothing_velocity};
   std::vector<double> shifts{0.0};
   if (options.sign == SmoothSign::kSigmoid) shifts.assign(kShiftGrid.begin(), kShiftGrid.end());
 
-  JointFrictionFit best;
-  Solve best_solve;
+  // The best friction alone, and the best friction with the inertia correction (each with its
+  // own Coulomb smoothing and shift).
+  JointFrictionFit best, best_with;
+  Solve<3> best_solve;
+  Solve<4> best_solve_with;
   for (const double vs : smoothings) {
     for (const double shift : shifts) {
       for (std::size_t k = 0; k < N; ++k) phi[k] = smooth_sign(options.sign, s.dq[k], vs, shift);
       filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
-      std::array<bool, 3> active{true, true, true};
-      Solve sol =
-          solve({&z_viscous, &z_coulomb, &z_offset}, s.r0, use, active, options.regularisation);
-      // Friction opposes motion: a negative coefficient is dropped and the rest refitted.
-      for (int c = 0; c < 2 && (sol.theta[0] < 0 || sol.theta[1] < 0); ++c) {
-        if (sol.theta[0] < 0) active[0] = false;
-        if (sol.theta[1] < 0) active[1] = false;
-        sol = solve({&z_viscous, &z_coulomb, &z_offset}, s.r0, use, active, options.regularisation);
-      }
+      const Solve<3> sol =
+          solve_friction<3>({&z_viscous, &z_coulomb, &z_offset}, s.r0, use, options.regularisation);
       if (sol.rss < best_solve.rss) {
         best_solve = sol;
         best.smoothing = vs;
         best.shift = shift;
+      }
+      if (!try_inertia) continue;
+      const Solve<4> with = solve_friction<4>({&z_viscous, &z_coulomb, &z_offset, &z_inertia}, s.r0,
+                                              use, options.regularisation);
+      if (with.rss < best_solve_with.rss) {
+        best_solve_with = with;
+        best_with.smoothing = vs;
+        best_with.shift = shift;
       }
     }
   }
@@ -183,6 +223,40 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   best.coulomb = best_solve.theta[1];
   best.offset = best_solve.theta[2];
   best.condition = best_solve.condition;
+  // The inertia correction is kept where it explains a clear share of what friction leaves (a
+  // few per cent would be noise fitted), where the regression stays well conditioned, and where
+  // it does so beyond a gravity error too: in a periodic motion q̈ follows q, and an error of
+  // g(q) (of the model's masses, or a payload on the last link) would be taken for an inertia.
+  // The gravity columns are nuisance regressors of this test only.
+  bool keep_inertia = try_inertia && best_solve_with.condition <= kMaxCondition &&
+                      best_solve_with.rss <= (1.0 - kMinInertiaGain) * best_solve.rss;
+  if (keep_inertia && !s.gravity.empty()) {
+    std::array<std::vector<double>, 5> z_gravity;
+    filter_regressor(s.gravity, s.alpha, z_gravity[0], s.filter_weight);
+    for (std::size_t c = 0; c < 4; ++c)
+      filter_regressor(s.payload_gravity[c], s.alpha, z_gravity[c + 1], s.filter_weight);
+    for (std::size_t k = 0; k < N; ++k)
+      phi[k] = smooth_sign(options.sign, s.dq[k], best.smoothing, best.shift);
+    filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
+    const Solve<8> g =
+        solve_friction<8>({&z_viscous, &z_coulomb, &z_offset, &z_gravity[0], &z_gravity[1],
+                           &z_gravity[2], &z_gravity[3], &z_gravity[4]},
+                          s.r0, use, options.regularisation);
+    const Solve<9> gi =
+        solve_friction<9>({&z_viscous, &z_coulomb, &z_offset, &z_gravity[0], &z_gravity[1],
+                           &z_gravity[2], &z_gravity[3], &z_gravity[4], &z_inertia},
+                          s.r0, use, options.regularisation);
+    keep_inertia = gi.rss <= (1.0 - kMinInertiaGain) * g.rss;
+  }
+  if (keep_inertia) {
+    best_with.viscous = best_solve_with.theta[0];
+    best_with.coulomb = best_solve_with.theta[1];
+    best_with.offset = best_solve_with.theta[2];
+    best_with.inertia = best_solve_with.theta[3];
+    best_with.inertia_gain = 1.0 - best_solve_with.rss / best_solve.rss;
+    best_with.condition = best_solve_with.condition;
+    best = best_with;
+  }
   if (best.viscous == 0.0) best.warnings.push_back(j + ": viscous friction fitted < 0, set to 0");
   if (best.coulomb == 0.0) best.warnings.push_back(j + ": Coulomb friction fitted < 0, set to 0");
   // The residual with the chosen friction, over the whole log.
@@ -193,6 +267,8 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   for (std::size_t k = 0; k < N; ++k)
     best.residual[k] = s.r0[k] + best.viscous * z_viscous[k] + best.coulomb * z_coulomb[k] +
                        best.offset * z_offset[k];
+  if (best.inertia != 0.0)
+    for (std::size_t k = 0; k < N; ++k) best.residual[k] += best.inertia * z_inertia[k];
   return best;
 }
 

@@ -2,6 +2,7 @@
 // (calibration.hpp explains the formulation).
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -13,13 +14,19 @@ namespace extwrench::calibration_detail {
 /// coefficient α_k = e^{−K Δt_k} of the step ending at sample k (α_0 unused). With a residual
 /// filter on the joint (observer.residual_cutoff), its weight per step (residual_filter.hpp;
 /// empty: none), and r⁰ is then the filtered residual: the fit minimises what the detector sees.
+/// dt_k = t_k − t_{k−1} (dt_0 unused; empty: no inertia correction fitted); gravity: g_i(q_k),
+/// and payload_gravity: the gravity torque of a unit mass at the last link's origin and of unit
+/// first moments along its x, y, z (empty: not known).
 struct JointSeries {
-  std::vector<double> dq, r0, alpha, filter_weight;
+  std::vector<double> dq, r0, alpha, dt, filter_weight, gravity;
+  std::array<std::vector<double>, 4> payload_gravity;
 };
 
 /// The fitted friction of one joint and its fit statistics.
 struct JointFrictionFit {
   double viscous = 0.0, coulomb = 0.0, offset = 0.0, smoothing = 0.05, shift = 0.0;
+  double inertia = 0.0;       ///< δI, the momentum's correction (0: not fitted) [kg m²]
+  double inertia_gain = 0.0;  ///< share of friction's residual sum of squares it removed
   double condition = 1.0;
   std::vector<double> residual;  ///< r(θ) over the whole log
   std::vector<std::string> warnings;
@@ -42,6 +49,12 @@ void filter_regressor(const std::vector<double>& phi, const std::vector<double>&
                       std::vector<double>& z,
                       const std::vector<double>& residual_filter_weight = {});
 
+/// The observer's filter of a rate of change: z_k = α_k z_{k−1} + (1 − α_k)(x_k − x_{k−1})/Δt_k,
+/// z_0 = 0 (a term δ x added to the momentum), then the residual filter as filter_regressor.
+void filter_rate(const std::vector<double>& x, const std::vector<double>& alpha,
+                 const std::vector<double>& dt, std::vector<double>& z,
+                 const std::vector<double>& residual_filter_weight = {});
+
 /// The residual filter over a series in place, with its weights per step (none when empty).
 void apply_residual_filter(const std::vector<double>& weight, std::vector<double>& x);
 
@@ -55,7 +68,10 @@ void apply_residual_filter(const std::vector<double>& weight, std::vector<double
 void check_excitation(const JointSeries& s, const std::vector<char>& use, int joint,
                       double smoothing);
 
-/// Fits D, F_c, o (and v_s, φ on a grid unless fixed) on the samples with use[k] != 0.
+/// Fits D, F_c, o (and v_s, φ on a grid unless fixed) on the samples with use[k] != 0; with
+/// options.inertia_correction also δI (p += δI q̇), kept where it lowers the residual's sum of
+/// squares by ≥ 10 % also beyond a gravity error (g_i(q) and a last-link payload's gravity as
+/// nuisance regressors, when s.gravity is known).
 [[nodiscard]] JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                                          const CalibrationOptions& options, int joint);
 

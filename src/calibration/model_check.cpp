@@ -80,10 +80,8 @@ std::string num(double x) {
 }  // namespace
 
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
-                  const std::vector<JointFrictionFit>& after,
-                  const std::vector<std::vector<double>>& gravity,
-                  const std::vector<Sample>& samples, const VectorX& residual_cutoff,
-                  const std::vector<char>& use, ModelCheck& check) {
+                  const std::vector<JointFrictionFit>& after, const std::vector<Sample>& samples,
+                  const VectorX& residual_cutoff, const std::vector<char>& use, ModelCheck& check) {
   const std::size_t n = series.size();
   const std::vector<double> suggested = residual_filter_weights(samples, kSuggestedCutoff);
   check.joint_rms = VectorX::Zero(static_cast<Eigen::Index>(n));
@@ -112,7 +110,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
                                     "): Coulomb friction the model lacks (calibrated)"});
     }
     // Follows g(q): the calibrated residual against the filtered gravity torque.
-    filter_regressor(gravity[i], s.alpha, z, s.filter_weight);
+    filter_regressor(s.gravity, s.alpha, z, s.filter_weight);
     const LineFit g = fit_line(z, after[i].residual, use);
     if (g.r2 >= kJointShare) {
       check.patterns.push_back({"gravity", joint, g.r2,
@@ -131,19 +129,28 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     // Beyond g(q): in a periodic motion the position, hence a gravity error, follows q̈ too.
     filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
     const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
-    if (inertia.extra_r2 >= kJointShare) {
-      const double delta = -inertia.slope;
+    const double delta = after[i].inertia != 0.0 ? after[i].inertia : -inertia.slope;
+    const std::string size_and_sign = "the robot's inertia along it is " + num(std::abs(delta)) +
+                                      " kg m^2 " + (delta > 0 ? "larger" : "smaller") +
+                                      " than the model's (" +
+                                      (delta > 0 ? "a rotor inertia the model lacks"
+                                                 : "the model's link inertias are too large, or "
+                                                   "the torque lags the velocity") +
+                                      ")";
+    if (after[i].inertia != 0.0) {
+      // Fitted with the friction (fit_joint): corrected in the observer's momentum.
+      check.patterns.push_back({"inertia", joint, after[i].inertia_gain,
+                                "joint " + std::to_string(joint) + ": " + size_and_sign +
+                                    "; corrected by observer.inertia_correction, which removes " +
+                                    num(100.0 * after[i].inertia_gain) +
+                                    " % of what friction leaves"});
+    } else if (inertia.extra_r2 >= kJointShare) {
       check.patterns.push_back(
           {"inertia", joint, inertia.extra_r2,
            "joint " + std::to_string(joint) +
                ": the calibrated residual follows the joint's acceleration (R^2 " +
-               num(inertia.extra_r2) + " beyond g(q)): the robot's inertia along it is " +
-               num(std::abs(delta)) + " kg m^2 " + (delta > 0 ? "larger" : "smaller") +
-               " than the model's (" +
-               (delta > 0 ? "a rotor inertia the model lacks: armature: in the configuration"
-                          : "the model's link inertias are too large, or the torque lags the "
-                            "velocity") +
-               ")"});
+               num(inertia.extra_r2) + " beyond g(q)): " + size_and_sign +
+               (delta > 0 ? "; armature: in the configuration" : "")});
     }
     // Mostly above ~20 Hz (unfiltered joints only): the velocity's noise through K B(q), or the
     // torque's, which the residual filter removes (docs/estimator.md#residual-filter).

@@ -10,13 +10,11 @@
 namespace extwrench::calibration_detail {
 
 /// Joint patterns. before[i].r0: the residual with the model as configured; after[i]: the
-/// calibrated residual; series[i]: q̇ and the observer's filter; gravity[i]: g_i(q_k); times:
-/// the log (its time stamps); residual_cutoff: the configured residual filter per joint (n).
+/// calibrated residual; series[i]: q̇, g_i(q_k) and the observer's filter; samples: the log
+/// (its time stamps); residual_cutoff: the configured residual filter per joint (n).
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
-                  const std::vector<JointFrictionFit>& after,
-                  const std::vector<std::vector<double>>& gravity,
-                  const std::vector<Sample>& samples, const VectorX& residual_cutoff,
-                  const std::vector<char>& use, ModelCheck& check);
+                  const std::vector<JointFrictionFit>& after, const std::vector<Sample>& samples,
+                  const VectorX& residual_cutoff, const std::vector<char>& use, ModelCheck& check);
 
 /// Base-sensor patterns from error_S = reading − predicted (no bias) and predicted_S, per used
 /// sample; `moments`: a 6-axis sensor.

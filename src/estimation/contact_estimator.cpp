@@ -61,6 +61,8 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   nominal_inertia_.reserve(model_.bodies.size());
   for (const Body& b : model_.bodies) nominal_inertia_.push_back(b.inertia);
   if (options_.friction) observer_.set_friction(*options_.friction);
+  observer_.set_inertia_correction(options_.inertia_correction);
+  inertia_corrected_ = !observer_.inertia_correction().isZero(0.0);
   tare_.bias_S = options_.sensor.bias_S;  // a calibrated bias (zero by default)
   if (options_.payload) apply_payload(options_.payload->body, &options_.payload->inertia);
   settle_time_ = settle_time_of(options_, observer_);
@@ -261,6 +263,9 @@ Status ContactEstimator::acceleration_route(double dt, const Eigen::Ref<const Ve
   // (b) q̈̂ = B⁻¹ (τ − τ_f + r − c(q, q̇)): forward dynamics with τ + r. The kinematics of q and
   // c = C q̇ + g (data_.tau) are already in data_ (stage 1).
   crba_no_kinematics(model_, data_);
+  // The joint-space inertia the observer assumes, B(q) + δI (options.inertia_correction), so that
+  // q̈̂ solves the same balance as the residual it comes from.
+  if (inertia_corrected_) data_.M.diagonal() += observer_.inertia_correction();
   ddq_ = tau_eff_ + observer_.residual() - data_.tau;
   bool factored = false;
   if (n_ <= kInlineJoints) {

@@ -94,7 +94,9 @@ std::string joint_table(const Calibration& c) {
       << ", threshold_at_rest: " << j.threshold_at_rest
       << ", threshold_per_speed: " << j.threshold_per_speed
       << ", mean_threshold_speed: " << j.mean_threshold_speed
-      << ", threshold_form: " << (j.speed_dependent ? "speed" : "constant") << "}\n";
+      << ", threshold_form: " << (j.speed_dependent ? "speed" : "constant")
+      << ", inertia_correction: " << j.inertia_correction << ", inertia_gain: " << j.inertia_gain
+      << "}\n";
   }
   return y.str();
 }
@@ -150,6 +152,8 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
   y << "observer: {gain: " << yaml_list(c.observer_gain);
   if ((c.residual_cutoff.array() > 0.0).any())
     y << ", residual_cutoff: " << yaml_list(c.residual_cutoff);
+  if (c.inertia_correction.size() > 0 && !c.inertia_correction.isZero(0.0))
+    y << ", inertia_correction: " << yaml_list(c.inertia_correction);
   y << "}\n";
   y << "friction: " << io_detail::friction_mapping_yaml(c.friction) << "\n";
   y << "detection: {tau_min: " << yaml_list(c.tau_threshold);
@@ -218,13 +222,17 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
     const io_detail::Range positive = io_detail::positive();
     const io_detail::Range non_negative = io_detail::non_negative(">= 0 [N]");
     const YAML::Node ob = rd.required(root, "", "observer");
-    rd.only_keys(ob, "observer", {"gain", "residual_cutoff"});
+    rd.only_keys(ob, "observer", {"gain", "residual_cutoff", "inertia_correction"});
     c.observer_gain = rd.vector(rd.required(ob, "observer", "gain"), "observer.gain", n, &positive);
     // Absent in files written before the residual filter: none.
     const io_detail::Range cutoff = io_detail::non_negative(">= 0 [Hz] (0: none)");
     c.residual_cutoff = ob["residual_cutoff"] ? rd.vector(ob["residual_cutoff"],
                                                           "observer.residual_cutoff", n, &cutoff)
                                               : VectorX::Zero(n);
+    // Absent where none was fitted (and in files written before it): zero.
+    c.inertia_correction = ob["inertia_correction"] ? rd.vector(ob["inertia_correction"],
+                                                                "observer.inertia_correction", n)
+                                                    : VectorX::Zero(n);
     c.friction =
         io_detail::read_friction_mapping(rd, rd.required(root, "", "friction"), n, "friction");
     const YAML::Node det = rd.required(root, "", "detection");

@@ -57,12 +57,14 @@ void read_contact(const YamlReader& rd, const YAML::Node& c, const Model& model,
 }
 
 void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorOptions& o) {
-  rd.only_keys(ob, "observer", {"gain", "residual_cutoff"});
+  rd.only_keys(ob, "observer", {"gain", "residual_cutoff", "inertia_correction"});
   const Range gain = positive();
   if (ob["gain"]) o.observer_gain = rd.vector(ob["gain"], "observer.gain", n, &gain);
   const Range cutoff = io_detail::non_negative(">= 0 [Hz] (0: none)");
   if (ob["residual_cutoff"])
     o.residual_cutoff = rd.vector(ob["residual_cutoff"], "observer.residual_cutoff", n, &cutoff);
+  if (ob["inertia_correction"])
+    o.inertia_correction = rd.vector(ob["inertia_correction"], "observer.inertia_correction", n);
 }
 
 void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionOptions& o) {
@@ -170,6 +172,9 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
   }
   const YAML::Node det = root["detection"];
   if (!root["friction"]) o.friction = cal.friction;
+  // δI was fitted with the calibration's friction: taken with it, unless set here.
+  if (!root["friction"] && !(ob && ob["inertia_correction"]) && cal.inertia_correction.size() > 0)
+    o.inertia_correction = cal.inertia_correction;
   if (!(det && det["tau_min"])) o.detection.tau_min = cal.tau_threshold;
   // The speed term belongs to the calibration's τ_min: taken with it, unless set here.
   if (!(det && (det["tau_min"] || det["tau_per_speed"])))
@@ -429,6 +434,8 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   y << "observer:\n  gain: " << io_detail::yaml_list(o.observer_gain) << '\n';
   if ((o.residual_cutoff.array() > 0.0).any())
     y << "  residual_cutoff: " << io_detail::yaml_list(o.residual_cutoff) << '\n';
+  if (!o.inertia_correction.isZero(0.0))
+    y << "  inertia_correction: " << io_detail::yaml_list(o.inertia_correction) << '\n';
   y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min);
   if ((o.detection.tau_per_speed.array() > 0.0).any())
     y << "\n  tau_per_speed: " << io_detail::yaml_list(o.detection.tau_per_speed);

@@ -30,6 +30,7 @@ MomentumObserver::MomentumObserver(const Model& model, double gain)
 MomentumObserver::MomentumObserver(const Model& model, const VectorX& gains) : n_(model.nq()) {
   if (n_ < 1) throw Error("MomentumObserver: model '" + model.name + "' has no joint");
   gains_ = checked_gains(gains, n_);
+  inertia_correction_ = VectorX::Zero(n_);
   friction_ = JointFriction::from_model(model);
   validate_friction(friction_, n_, "MomentumObserver: model '" + model.name + "'");
   r_ = VectorX::Zero(n_);
@@ -60,6 +61,19 @@ void MomentumObserver::set_friction(const JointFriction& friction) {
   }
 }
 
+void MomentumObserver::set_inertia_correction(const VectorX& inertia_correction) {
+  if (inertia_correction.size() != 1 && inertia_correction.size() != n_) {
+    throw Error("MomentumObserver: inertia correction: expected 1 or " + std::to_string(n_) +
+                " values, got " + std::to_string(inertia_correction.size()));
+  }
+  if (!inertia_correction.allFinite())
+    throw Error("MomentumObserver: inertia correction: expected finite values");
+  const VectorX delta = per_joint(inertia_correction, n_);
+  // The last momentum with the new δI: the next Δy contains no jump (as reanchor).
+  if (initialized_) m_prev_ += (delta - inertia_correction_).cwiseProduct(dq_prev_);
+  inertia_correction_ = delta;
+}
+
 void MomentumObserver::shift_offset(const Eigen::Ref<const VectorX>& delta) noexcept {
   friction_.offset += delta;
   if (initialized_) {
@@ -79,13 +93,18 @@ void MomentumObserver::integrand(const Data& data, const Eigen::Ref<const Vector
   gamma_ = data.coriolis_transpose_dq - data.gravity_torque - tau_f_;
 }
 
+void MomentumObserver::anchor_momentum(const Data& data,
+                                       const Eigen::Ref<const VectorX>& dq) noexcept {
+  for (int i = 0; i < n_; ++i) m_prev_[i] = data.momentum[i] + inertia_correction_[i] * dq[i];
+}
+
 void MomentumObserver::reanchor(const Model& model, Data& data) noexcept {
   // The momentum of the last sample is recomputed with the edited model, so the next Δy
   // contains no jump and r stays continuous.
   if (!initialized_) return;
   momentum_terms(model, data, q_prev_, dq_prev_);
   integrand(data, dq_prev_);
-  m_prev_ = data.momentum;
+  anchor_momentum(data, dq_prev_);
   gamma_prev_ = gamma_;
 }
 
@@ -100,7 +119,7 @@ Status MomentumObserver::reset(const Model& model, Data& data, double t,
   integrand(data, dq);
   t_ = t;
   r_.setZero();
-  m_prev_ = data.momentum;
+  anchor_momentum(data, dq);
   gamma_prev_ = gamma_;
   q_prev_ = q;
   dq_prev_ = dq;
@@ -157,12 +176,13 @@ void MomentumObserver::integrate(const Data& data, double t, const Eigen::Ref<co
   const VectorX& m = data.momentum;
   const double inv_dt = 1.0 / dt;
   for (int i = 0; i < n_; ++i) {
-    // Δy = m_{k+1} − m_k − Δt (τ_k + ½ (γ_k + γ_{k+1}))
-    const double dy = m[i] - m_prev_[i] - dt * (tau_hold[i] + 0.5 * (gamma_prev_[i] + gamma_[i]));
+    const double p = m[i] + inertia_correction_[i] * dq[i];  // p = B q̇ + δI q̇ (δI = 0: m)
+    // Δy = p_{k+1} − p_k − Δt (τ_k + ½ (γ_k + γ_{k+1}))
+    const double dy = p - m_prev_[i] - dt * (tau_hold[i] + 0.5 * (gamma_prev_[i] + gamma_[i]));
     // Exact solution of ṙ = K (Δy/Δt − r) over the step.
     r_[i] = alpha_[i] * r_[i] + (1.0 - alpha_[i]) * dy * inv_dt;
+    m_prev_[i] = p;
   }
-  m_prev_ = m;
   gamma_prev_ = gamma_;
   tau_prev_ = tau;
   have_tau_ = true;

@@ -110,9 +110,12 @@ TEST(CalibrationInput, ShortContactIsExcludedAndNamedWithItsWindow) {
 }
 
 // 2 s of contact in 8 s: refused (more than max_contact_fraction flagged) or at least warned
-// about with a window inside the push. (A contact on the proximal links over half of a log is
-// absorbed by the fit too well to be recognised: docs/calibration.md.)
-TEST(CalibrationInput, LongContactIsRefusedOrWarnedWithItsWindow) {
+// about with a window inside the push, with or without the inertia correction (which could
+// absorb the push's part that follows q̈: contacts are looked for before it is fitted). (A
+// contact on the proximal links over half of a log is absorbed by the fit too well to be
+// recognised: docs/calibration.md.)
+class LongContact : public ::testing::TestWithParam<bool> {};
+TEST_P(LongContact, IsRefusedOrWarnedWithItsWindow) {
   sim::ForceProfile push;
   push.frame = "link6";
   push.point_F = Vector3(0.1, 0, 0);
@@ -120,8 +123,10 @@ TEST(CalibrationInput, LongContactIsRefusedOrWarnedWithItsWindow) {
   push.start = 3.0;
   push.end = 5.0;
   push.ramp = 0.05;
+  CalibrationOptions co;
+  co.inertia_correction = GetParam();
   try {
-    const Calibration cal = calibrate(paper_arm(), no_sensor(), free_log(8.0, {push}));
+    const Calibration cal = calibrate(paper_arm(), no_sensor(), free_log(8.0, {push}), co);
     ASSERT_FALSE(cal.suspect_windows.empty()) << "a 2 s push went unnoticed";
     for (const SuspectWindow& w : cal.suspect_windows) {
       EXPECT_GE(w.t_end, push.start);
@@ -135,6 +140,9 @@ TEST(CalibrationInput, LongContactIsRefusedOrWarnedWithItsWindow) {
     EXPECT_NE(what.find("[3."), std::string::npos) << what;
   }
 }
+INSTANTIATE_TEST_SUITE_P(CalibrationInput, LongContact, ::testing::Bool(), [](const auto& info) {
+  return info.param ? "InertiaCorrection" : "FrictionOnly";
+});
 
 TEST(CalibrationInput, JointThatDoesNotMoveIsNamed) {
   sim::SinusoidalTrajectory still = test::free_motion(0.0, 1.0);
@@ -402,6 +410,121 @@ TEST(CalibrationFile, TheResidualFilterIsCalibratedAndCarriedWithItsThresholds) 
   // Written back, the configuration keeps the cutoff.
   const EstimatorConfig again = load_estimator_config_string(to_yaml(cfg, dir), dir / "w.yaml");
   EXPECT_EQ(again.options.residual_cutoff, options.residual_cutoff);
+}
+
+// The inertia correction (observer.inertia_correction) through calibration: on an arm with a
+// rotor the model lacks, the fitted δI enters the estimator's observer so that its residual is
+// exactly the fit's (the regressor is the observer's own law); CALIB.yaml carries δI to the
+// configuration that includes it; a configuration's own value wins; a bad one is named.
+TEST(CalibrationFile, TheInertiaCorrectionIsTheEstimatorsResidual) {
+  const Model model = paper_arm();
+  Model rotors = model;
+  rotors.joints[4].armature = 0.25;  // joint 4 (joints[0] is the base's)
+  const auto log =
+      test::simulate_free_motion(rotors, test::free_motion(0.0, 1.0), test::paper_arm_friction(),
+                                 8.0, Vector6::Zero(), 0.02, 5);
+  CalibrationOptions with_inertia;
+  with_inertia.inertia_correction = true;
+  Calibration cal = calibrate(model, no_sensor(), log, with_inertia);
+  ASSERT_EQ(cal.inertia_correction.size(), 7);
+  EXPECT_NEAR(cal.inertia_correction[3], 0.25, 0.005);
+  EXPECT_EQ(cal.joints[3].inertia_correction, cal.inertia_correction[3]);
+  EXPECT_GT(cal.joints[3].inertia_gain, 0.5);
+  const EstimatorOptions applied = apply_calibration(no_sensor(), cal);
+  EXPECT_EQ(applied.inertia_correction, cal.inertia_correction);
+  ContactEstimator est(model, GeometryModel{}, applied);
+  ASSERT_TRUE(est.reset(log.front()).ok());
+  VectorX sum2 = VectorX::Zero(7);
+  int count = 0;
+  for (std::size_t k = 1; k < log.size(); ++k) {
+    ASSERT_TRUE(est.update(log[k]).ok());
+    if (log[k].t - log.front().t < 5.0 / 50.0 - 1e-9) continue;
+    sum2 += est.result().residual.cwiseAbs2();
+    ++count;
+  }
+  ASSERT_EQ(count, cal.samples_used);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_NEAR(std::sqrt(sum2[i] / count), cal.joints[static_cast<std::size_t>(i)].rms_after, 1e-9)
+        << "joint " << i + 1;
+  }
+  cal.source = "free.csv";
+  const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_inertia";
+  fs::create_directories(dir);
+  std::ofstream(dir / "calib.yaml") << calibration_to_yaml(cal, nullptr);
+  EXPECT_EQ(load_calibration(dir / "calib.yaml", 7).inertia_correction, cal.inertia_correction);
+  const std::string robot = (fs::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf").string();
+  const std::string head = "robot: " + robot + "\nsensor: {type: none}\n";
+  const EstimatorConfig cfg = load_estimator_config_string(
+      head + "observer: {gain: 50}\ncalibration: calib.yaml\n", dir / "config.yaml");
+  EXPECT_EQ(cfg.options.inertia_correction, cal.inertia_correction);
+  const EstimatorConfig own = load_estimator_config_string(
+      head + "observer: {gain: 50, inertia_correction: 0.1}\ncalibration: calib.yaml\n",
+      dir / "config.yaml");
+  EXPECT_EQ(own.options.inertia_correction, VectorX::Constant(7, 0.1));
+  // Written back, the configuration keeps it.
+  const EstimatorConfig again = load_estimator_config_string(to_yaml(cfg, dir), dir / "w.yaml");
+  EXPECT_EQ(again.options.inertia_correction, cal.inertia_correction);
+  for (const char* bad : {"[0, 0, 0]", ".nan", "heavy"}) {
+    try {
+      (void)load_estimator_config_string(
+          head + "observer: {gain: 50, inertia_correction: " + bad + "}\n", dir / "config.yaml");
+      FAIL() << "inertia_correction: " << bad << " was accepted";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("config.yaml:3"), std::string::npos) << what;
+      EXPECT_NE(what.find("observer.inertia_correction"), std::string::npos) << what;
+    }
+  }
+}
+
+// δI is the armature to every stage of the estimator that uses B(q): with a base F/T sensor
+// (route (b): q̈̂ from B + δI, the base wrench's prediction from it) and a push on link 6, the
+// estimator on the model without rotors but with δI = the rotors' armature gives what the
+// estimator on the model with them gives (Model::joints[i].armature, added by the dynamics).
+TEST(InertiaCorrection, IsTheArmatureToTheWholeEstimator) {
+  const Model model = paper_arm();
+  Model rotors = model;
+  rotors.joints[2].armature = 0.3;
+  rotors.joints[6].armature = 0.05;
+  VectorX armature = VectorX::Zero(7);
+  armature[1] = 0.3;
+  armature[5] = 0.05;
+  sim::ForceProfile push;
+  push.frame = "link6";
+  push.point_F = Vector3(0.1, 0, 0);
+  push.force = Vector3(0, 15, 0);
+  push.start = 1.0;
+  push.end = 1.5;
+  push.ramp = 0.02;
+  const auto log =
+      test::simulate_free_motion(rotors, test::free_motion(0.0, 1.0), test::paper_arm_friction(),
+                                 2.0, Vector6::Zero(), 0.0, 5, {push});
+  EstimatorOptions options;
+  options.sensor.type = SensorType::kForceTorque;
+  options.friction = JointFriction::none(7);
+  ContactEstimator with_rotors(rotors, GeometryModel{}, options);
+  options.inertia_correction = armature;
+  ContactEstimator corrected(model, GeometryModel{}, options);
+  ASSERT_TRUE(with_rotors.reset(log.front()).ok());
+  ASSERT_TRUE(corrected.reset(log.front()).ok());
+  double worst_residual = 0, worst_force = 0, peak_force = 0;
+  int contacts = 0;
+  for (std::size_t k = 1; k < log.size(); ++k) {
+    ASSERT_TRUE(with_rotors.update(log[k]).ok());
+    ASSERT_TRUE(corrected.update(log[k]).ok());
+    const ContactEstimate& a = with_rotors.result();
+    const ContactEstimate& b = corrected.result();
+    worst_residual = std::max(worst_residual, (a.residual - b.residual).cwiseAbs().maxCoeff());
+    EXPECT_EQ(a.contact, b.contact) << "t = " << log[k].t;
+    if (!a.contact) continue;
+    ++contacts;
+    worst_force = std::max(worst_force, (a.force_W - b.force_W).norm());
+    peak_force = std::max(peak_force, a.force_W.norm());
+  }
+  EXPECT_GT(contacts, 300);
+  EXPECT_GT(peak_force, 10.0);
+  EXPECT_LT(worst_residual, 1e-9);
+  EXPECT_LT(worst_force, 1e-9 * peak_force);
 }
 
 }  // namespace

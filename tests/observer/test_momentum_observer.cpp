@@ -265,6 +265,61 @@ TEST(MomentumObserver, PayloadSetAtRunTimeMatchesTheLoadedRobotWithoutAJumpOrAll
   EXPECT_LT(max_after, 2e-3 * r_before);
 }
 
+// δI in the observer's momentum is the same residual as the model's armature (which the
+// dynamics add inside momentum_terms, docs/model.md "Armature"): an arm with rotors on joints 2
+// and 5 observed on the model without them, corrected by δI, matches the observer that has them,
+// also when δI is set mid-run (no jump), and an observer on the rotor model with δI = −I_a
+// (Model::joints[0] is the base's: joint i is joints[i], δI's entry i − 1)
+// matches the one without rotors (a negative correction).
+TEST(MomentumObserver, InertiaCorrectionActsAsTheArmatureAlongTheJoints) {
+  const Model bare = test::paper_arm_model();
+  Model rotors = bare;
+  rotors.joints[1].armature = 0.4;
+  rotors.joints[4].armature = 0.15;
+  VectorX armature = VectorX::Zero(7);
+  armature[0] = 0.4;
+  armature[3] = 0.15;
+  SimulatedArm arm(rotors);
+  Data ctrl(rotors);
+  SineTracker tracker(7);
+  MomentumObserver on_rotors(rotors, 80.0), corrected(bare, 80.0), late(bare, 80.0),
+      plain(bare, 80.0), negative(rotors, 80.0);
+  corrected.set_inertia_correction(armature);
+  negative.set_inertia_correction(-armature);
+  Data d_rotors(rotors), d_bare(bare);
+  VectorX tau = tracker.torque(rotors, ctrl, 0, arm.q, arm.dq);
+  for (MomentumObserver* o : {&corrected, &late, &plain})
+    ASSERT_TRUE(o->reset(bare, d_bare, 0, arm.q, arm.dq, tau).ok());
+  for (MomentumObserver* o : {&on_rotors, &negative})
+    ASSERT_TRUE(o->reset(rotors, d_rotors, 0, arm.q, arm.dq, tau).ok());
+  double worst = 0, worst_late = 0, worst_negative = 0, plain_peak = 0;
+  for (int k = 0; k < 1500; ++k) {
+    if (k == 500) late.set_inertia_correction(armature);
+    arm.step(tau, kDt);
+    tau = tracker.torque(rotors, ctrl, arm.t, arm.q, arm.dq);
+    for (MomentumObserver* o : {&corrected, &late, &plain})
+      ASSERT_TRUE(o->update(bare, d_bare, arm.t, arm.q, arm.dq, tau).ok());
+    for (MomentumObserver* o : {&on_rotors, &negative})
+      ASSERT_TRUE(o->update(rotors, d_rotors, arm.t, arm.q, arm.dq, tau).ok());
+    const double scale = std::max(1.0, on_rotors.residual().cwiseAbs().maxCoeff());
+    worst = std::max(worst,
+                     (corrected.residual() - on_rotors.residual()).cwiseAbs().maxCoeff() / scale);
+    worst_negative = std::max(
+        worst_negative, (negative.residual() - plain.residual()).cwiseAbs().maxCoeff() / scale);
+    plain_peak =
+        std::max(plain_peak, (plain.residual() - on_rotors.residual()).cwiseAbs().maxCoeff());
+    if (k >= 500 + 8 * 12)  // 8 time constants after the change: its past has decayed
+      worst_late = std::max(worst_late,
+                            (late.residual() - on_rotors.residual()).cwiseAbs().maxCoeff() / scale);
+  }
+  EXPECT_LT(worst, 1e-12);
+  EXPECT_LT(worst_negative, 1e-12);
+  EXPECT_LT(worst_late, 1e-3);
+  EXPECT_GT(plain_peak, 0.05);  // without δI the rotors show as an external torque
+  EXPECT_THROW(plain.set_inertia_correction(VectorX::Ones(3)), Error);
+  EXPECT_THROW(plain.set_inertia_correction(VectorX::Constant(7, std::nan(""))), Error);
+}
+
 TEST(MomentumObserver, RejectsNonPositiveOrWrongSizedGains) {
   const Model model = test::paper_arm_model();
   EXPECT_THROW(MomentumObserver(model, 0.0), Error);

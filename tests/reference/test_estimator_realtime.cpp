@@ -52,7 +52,8 @@ struct Config {
   SensorType sensor;
   ContactModel contact;
   AccelerationRoute route;
-  double residual_cutoff = 0.0;  ///< [Hz] the residual filter (0: none)
+  double residual_cutoff = 0.0;     ///< [Hz] the residual filter (0: none)
+  double inertia_correction = 0.0;  ///< [kg m^2] δI on every joint (0: none)
 };
 
 std::vector<Config> all_configs() {
@@ -64,8 +65,9 @@ std::vector<Config> all_configs() {
         out.push_back({s, c, r});
       }
     }
-    // The residual filter's state too (observer.residual_cutoff).
-    out.push_back({s, ContactModel::kPureForce, AccelerationRoute::kResidual, 80.0});
+    // The residual filter's state too (observer.residual_cutoff), with a calibration's inertia
+    // correction (observer.inertia_correction: the momentum and, route (b), B + δI).
+    out.push_back({s, ContactModel::kPureForce, AccelerationRoute::kResidual, 80.0, 0.05});
   }
   return out;
 }
@@ -82,13 +84,16 @@ EstimatorOptions options_for(const Config& c) {
   o.detection.tau_min = VectorX::Constant(1, 0.05);
   o.sensor.tare_samples = 5;
   o.residual_cutoff = VectorX::Constant(1, c.residual_cutoff);
+  o.inertia_correction = VectorX::Constant(1, c.inertia_correction);
   return o;
 }
 
 std::string describe(const Config& c) {
   return std::string(to_string(c.sensor)) + "/" + std::string(to_string(c.contact)) + "/" +
          std::string(to_string(c.route)) +
-         (c.residual_cutoff > 0 ? "/residual_cutoff " + std::to_string(c.residual_cutoff) : "");
+         (c.residual_cutoff > 0 ? "/residual_cutoff " + std::to_string(c.residual_cutoff) : "") +
+         (c.inertia_correction != 0 ? "/inertia_correction " + std::to_string(c.inertia_correction)
+                                    : "");
 }
 
 TEST(EstimatorRealTime, TenThousandUpdatesOfEveryConfigurationAllocateNothing) {

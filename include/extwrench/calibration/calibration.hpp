@@ -42,6 +42,12 @@ struct CalibrationOptions {
   double contact_sigma = 12.0;          ///< a contact: residual above this many robust σ ...
   double contact_min_duration = 0.05;   ///< ... for at least this long [s]
   double max_contact_fraction = 0.2;    ///< more suspected contact than this: refused
+  /// Also fit, per joint, a correction δI of the inertia along the joint in the observer's
+  /// momentum (p = B(q) q̇ + δI q̇, EstimatorOptions::inertia_correction) with the friction, kept
+  /// where it lowers the residual's sum of squares by ≥ 10 %, also beyond a gravity error
+  /// (docs/calibration.md#inertia-correction). Opt-in: it lowers thresholds, and on an
+  /// unfiltered noisy residual a threshold lowered from a short log can be crossed later.
+  bool inertia_correction = false;
   bool payload = false;  ///< identify a payload on the last link (needs a base F/T sensor)
   /// The samples' true_tau_ext is an external torque known during the recording (a force plate
   /// or a known load: J_vᵀF), subtracted from the residual before the fit, so a log in contact
@@ -84,6 +90,8 @@ struct JointFitReport {
   double threshold_per_speed = 0.0;   ///< b of a + b|q̇| [N m s/rad]
   double mean_threshold_speed = 0.0;  ///< mean of a + b|q̇| over the samples used [N m]
   bool speed_dependent = false;       ///< the threshold chosen is a + b|q̇| (b > 0)
+  double inertia_correction = 0.0;    ///< δI fitted [kg m² | kg] (0: none)
+  double inertia_gain = 0.0;          ///< share of the friction fit's sum of squares it removed
 };
 
 /// A recognisable error of the model named by the model check (docs/calibration.md#model-check).
@@ -118,6 +126,10 @@ struct Calibration {
   /// The residual filter's cutoff per joint they were computed with (n) [Hz] (0: none;
   /// residual_filter.hpp).
   VectorX residual_cutoff;
+  /// δI per joint (n) [kg m² | kg]: the observer's momentum correction fitted with the friction
+  /// (0 where not kept; EstimatorOptions::inertia_correction). Empty when loaded from a file
+  /// written before it existed.
+  VectorX inertia_correction;
   SensorType sensor_type = SensorType::kNone;
   Vector6 sensor_bias_S = Vector6::Zero();  ///< [f; n] in S (moment zero for a force sensor)
   Vector3 force_noise_W = Vector3::Zero();  ///< std of F̂_ext per world axis after the bias [N]
@@ -154,7 +166,8 @@ struct Calibration {
 [[nodiscard]] bool add_identified_payload(const Calibration& calibration,
                                           EstimatorOptions& options);
 
-/// The options with the calibration applied: friction, residual_cutoff, detection.tau_min and
+/// The options with the calibration applied: friction, residual_cutoff, inertia_correction,
+/// detection.tau_min and
 /// tau_per_speed,
 /// (with a sensor) f_min and the sensor bias, and an identified payload (added to a configured
 /// one on the same body; throws extwrench::Error when the configured one is on another body).

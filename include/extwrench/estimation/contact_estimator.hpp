@@ -147,6 +147,7 @@ class ContactEstimator {
   Data data_;
   GeometryModel geometry_;
   MomentumObserver observer_;
+  bool inertia_corrected_ = false;  ///< options_.inertia_correction is not zero
   ResidualFilter residual_filter_;  ///< options_.residual_cutoff on τ̂_ext (off at 0)
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved

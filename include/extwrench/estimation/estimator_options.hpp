@@ -58,6 +58,11 @@ struct EstimatorOptions {
   /// (residual_filter.hpp); 0: none. For real arms whose q̇ noise reaches r through K B(q) δq̇
   /// (docs/estimator.md#residual-filter).
   VectorX residual_cutoff = VectorX::Zero(1);
+  /// δI [kg m² | kg], size 1 or n, finite, any sign: added to the momentum the observer
+  /// differentiates, p = B(q) q̇ + δI q̇ (a constant error of the inertia along each joint,
+  /// identified by `extwrench calibrate`); 0: none. The residual only: q̈̂ and the base wrench
+  /// keep B(q) (docs/calibration.md#inertia-correction).
+  VectorX inertia_correction = VectorX::Zero(1);
   std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction
   std::optional<PayloadOptions> payload;
   SolverOptions solver;

@@ -51,6 +51,12 @@ class MomentumObserver {
   /// the current interval's integrand corrected like set_friction. Needs friction().offset of
   /// size n (set_friction with an offset first).
   void shift_offset(const Eigen::Ref<const VectorX>& delta) noexcept;
+  /// Sets δI (size n or 1, finite, any sign): the momentum becomes p = B(q) q̇ + δI q̇, a
+  /// constant error of the inertia along each joint (calibration.hpp). Throws extwrench::Error
+  /// on a bad size or value. Once initialized, the last momentum is corrected too (no jump).
+  void set_inertia_correction(const VectorX& inertia_correction);
+  [[nodiscard]] const VectorX& inertia_correction() const noexcept { return inertia_correction_; }
+
   /// Sets the friction's torque offsets o_i to `offset` (n) exactly, for a reset to follow
   /// (the current interval's integrand is not corrected). Allocation-free; needs friction().offset
   /// of size n.
@@ -107,17 +113,20 @@ class MomentumObserver {
  private:
   /// τ_f(q̇) and γ = Cᵀq̇ − g − τ_f from the momentum terms in `data`.
   void integrand(const Data& data, const Eigen::Ref<const VectorX>& dq) noexcept;
+  /// m_prev_ = data.momentum + δI q̇: the momentum of a new anchor sample.
+  void anchor_momentum(const Data& data, const Eigen::Ref<const VectorX>& dq) noexcept;
 
   int n_ = 0;
   VectorX gains_;
   JointFriction friction_;
+  VectorX inertia_correction_;  ///< δI (n); zero by default
 
   // State.
   bool initialized_ = false;
   bool have_tau_ = false;  ///< tau_prev_ holds the torque of the current interval
   double t_ = 0.0;
   VectorX r_;           ///< residual r_k
-  VectorX m_prev_;      ///< m_k = B(q_k) q̇_k
+  VectorX m_prev_;      ///< m_k = B(q_k) q̇_k + δI q̇_k
   VectorX gamma_prev_;  ///< γ_k = Cᵀq̇ − g − τ_f at sample k
   VectorX tau_prev_;    ///< τ_k (held over [t_k, t_{k+1}))
   VectorX q_prev_, dq_prev_;
