@@ -85,7 +85,7 @@ std::string force_script(const PlotContext& c, const Figure& f) {
   for (int k = 0; k < 3; ++k) {
     s << "set ylabel 'F_" << kAxis[k] << " [N]'\nunset xlabel\n";
     plot_series(s, c,
-                {{kF + k, "with lines lw 2 lc rgb '#1f77b4'", "estimated"},
+                {{kF + k, "with linespoints lw 2 pt 7 ps 0.3 lc rgb '#1f77b4'", "estimated"},
                  {kFPartial + k, "with points pt 7 ps 0.5 lc rgb '#999999'", "partial"},
                  {kFt + k, "with lines lw 2 dt 2 lc rgb '#d62728'", "true"}},
                 "no force estimated (no contact detected)");
@@ -113,7 +113,7 @@ std::string line_point_script(const PlotContext& c, const Figure& f) {
     s << "set ylabel 'p_" << kAxis[k] << " [m]'\n"
       << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n");
     plot_series(s, c,
-                {{kL + k, "with lines lw 2 lc rgb '#1f77b4'", "estimated p̂"},
+                {{kL + k, "with linespoints lw 2 pt 7 ps 0.3 lc rgb '#1f77b4'", "estimated p̂"},
                  {kPt + k, "with lines lw 2 dt 2 lc rgb '#d62728'", "true point"}},
                 "no line of action estimated");
   }

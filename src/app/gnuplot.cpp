@@ -225,10 +225,12 @@ std::string gnuplot_png_preamble(const std::filesystem::path& png, int width, in
   s << "set terminal pngcairo size " << width << "," << height
     << " enhanced font 'DejaVu Sans,11'\n"
     << "set output " << gnuplot_quote(png.filename().string()) << "\n"
-    << "set grid\nset key outside right top\nset datafile missing 'NaN'\n";
+    << "set grid\nset key outside right top\n";
   return s.str();
 }
 
+// NaN in the data is gnuplot's "invalid" value (no `set datafile missing 'NaN'`): a line stops
+// at it, so a series is not drawn across spans without a value (no contact, a partial estimate).
 std::string gnuplot_preamble(const std::filesystem::path& file, FigureFormat format, int width,
                              int height) {
   std::ostringstream s;
@@ -246,7 +248,7 @@ std::string gnuplot_preamble(const std::filesystem::path& file, FigureFormat for
   s << " enhanced font 'DejaVu Sans,11'\n"
     << "if (!exists('out')) out = " << gnuplot_quote(file.filename().string()) << "\n"
     << "set output out\n"
-    << "set grid\nset key outside right top\nset datafile missing 'NaN'\n";
+    << "set grid\nset key outside right top\n";
   return s.str();
 }
 
