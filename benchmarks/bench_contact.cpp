@@ -186,6 +186,28 @@ void register_contact_benchmarks() {
           run_update(state, arm.model, arm.geometry, o, link6);
         });
   }
+  // Everything a calibration brings (issue 10, acceptance 5): tanh friction with per-joint
+  // smoothing and offsets, thresholds that follow |q̇|, the residual filter on joints 1-4 and an
+  // inertia correction; against the plain update above in the same binary.
+  for (const Config& c : {kTableI[0], kTableI[4]}) {
+    benchmark::RegisterBenchmark(
+        (std::string("BM_FullUpdate_Ours/") + c.name + "/capsules/calibrated").c_str(),
+        [&arm, &link6, c](benchmark::State& state) {
+          EstimatorOptions o = options_for(c, link6);
+          const int n = arm.model.nq();
+          JointFriction f = JointFriction::none(n);
+          f.sign = SmoothSign::kTanh;
+          f.viscous = VectorX::Constant(n, 0.01);
+          f.coulomb = VectorX::Constant(n, 0.01);
+          f.offset = VectorX::Constant(n, 0.001);
+          f.joint_smoothing = VectorX::Constant(n, 0.05);
+          o.friction = f;
+          o.detection.tau_per_speed = VectorX::Constant(1, 0.01);
+          o.residual_cutoff = VectorX{{20, 20, 20, 20, 0, 0, 0}};
+          o.inertia_correction = VectorX::Constant(n, 0.01);
+          run_update(state, arm.model, arm.geometry, o, link6);
+        });
+  }
   if (const MeshArm* panda = panda_arm(); panda != nullptr) {
     const Trajectory& tr = *panda_trajectory();
     for (const Config& c : {kTableI[0], kTableI[4]}) {

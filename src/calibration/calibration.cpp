@@ -340,11 +340,12 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
 // g_i(q_k) along the log (the model check's gravity pattern), and the gravity torques of a unit
 // mass at the last link's origin and of unit first moments along its axes (a payload's, linear
 // in m and m c): with g_i, the nuisance regressors that keep the inertia fit from taking a
-// gravity error for an inertia (fit_joint).
-void gravity_series(const Model& model, const std::vector<Sample>& samples,
+// gravity error for an inertia (fit_joint); computed only for it (`payload_columns`).
+void gravity_series(const Model& model, const std::vector<Sample>& samples, bool payload_columns,
                     std::vector<JointSeries>& series) {
   const int n = model.nq();
   const std::size_t N = samples.size();
+  const std::size_t count = payload_columns ? 5 : 1;
   std::array<Model, 5> models{model, model, model, model, model};
   for (std::size_t c = 1; c < 5; ++c) {
     Inertia unit;
@@ -355,17 +356,20 @@ void gravity_series(const Model& model, const std::vector<Sample>& samples,
   }
   for (JointSeries& js : series) {
     js.gravity.assign(N, 0.0);
-    for (std::vector<double>& p : js.payload_gravity) p.assign(N, 0.0);
+    if (payload_columns)
+      for (std::vector<double>& p : js.payload_gravity) p.assign(N, 0.0);
   }
   std::array<VectorX, 5> g;
   std::vector<Data> data;  // one per model: Data caches its model's mass properties
-  data.reserve(5);
-  for (const Model& mc : models) data.emplace_back(mc);
+  data.reserve(count);
+  for (std::size_t c = 0; c < count; ++c) data.emplace_back(models[c]);
   for (std::size_t k = 0; k < N; ++k) {
-    for (std::size_t c = 0; c < 5; ++c) g[c] = gravity_torques(models[c], data[c], samples[k].q);
+    for (std::size_t c = 0; c < count; ++c)
+      g[c] = gravity_torques(models[c], data[c], samples[k].q);
     for (int i = 0; i < n; ++i) {
       JointSeries& js = series[static_cast<std::size_t>(i)];
       js.gravity[k] = g[0][i];
+      if (!payload_columns) continue;
       js.payload_gravity[0][k] = g[1][i] - g[0][i];
       for (std::size_t a = 1; a < 4; ++a) js.payload_gravity[a][k] = g[a + 1][i] - g[1][i];
     }
@@ -506,7 +510,7 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
       remove_known_torque(samples, static_cast<int>(i), series[i], before[i]);
   }
 
-  gravity_series(m, samples, series);
+  gravity_series(m, samples, o.inertia_correction, series);
   cal.observer_gain = gains;
   cal.residual_cutoff = per_joint(options.residual_cutoff, n);
   // The residual filter: every series from here on is the filtered residual (r is linear in θ,

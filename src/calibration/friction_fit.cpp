@@ -69,8 +69,8 @@ Solve<C> solve(const std::array<const std::vector<double>*, C>& z, const std::ve
   return out;
 }
 
-// The friction columns (D, F_c, o) and, with `inertia`, the inertia correction's: solved, a
-// negative friction coefficient dropped and the rest refitted (friction opposes motion).
+// Columns D, F_c, o first, then any others (gravity, inertia correction): solved, a negative
+// friction coefficient dropped and the rest refitted (friction opposes motion).
 template <int C>
 Solve<C> solve_friction(const std::array<const std::vector<double>*, C>& z,
                         const std::vector<double>& r0, const std::vector<char>& use,
@@ -230,7 +230,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   // The gravity columns are nuisance regressors of this test only.
   bool keep_inertia = try_inertia && best_solve_with.condition <= kMaxCondition &&
                       best_solve_with.rss <= (1.0 - kMinInertiaGain) * best_solve.rss;
-  if (keep_inertia && !s.gravity.empty()) {
+  if (keep_inertia && !s.payload_gravity[0].empty()) {
     std::array<std::vector<double>, 5> z_gravity;
     filter_regressor(s.gravity, s.alpha, z_gravity[0], s.filter_weight);
     for (std::size_t c = 0; c < 4; ++c)

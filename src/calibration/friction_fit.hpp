@@ -71,7 +71,7 @@ void check_excitation(const JointSeries& s, const std::vector<char>& use, int jo
 /// Fits D, F_c, o (and v_s, φ on a grid unless fixed) on the samples with use[k] != 0; with
 /// options.inertia_correction also δI (p += δI q̇), kept where it lowers the residual's sum of
 /// squares by ≥ 10 % also beyond a gravity error (g_i(q) and a last-link payload's gravity as
-/// nuisance regressors, when s.gravity is known).
+/// nuisance regressors, when s.payload_gravity is known).
 [[nodiscard]] JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                                          const CalibrationOptions& options, int joint);
 
