@@ -333,6 +333,27 @@ TEST(CalibrationFile, SpeedThresholdsRoundTripAndOldFilesStillLoad) {
   }
 }
 
+// The estimator with a calibration applied, over the samples the fit used (after 5/K at K =
+// 50): its residual's RMS per joint, which must be the report's rms_after (the fit's residual).
+void expect_estimator_residual_is_the_fits(const Model& model, const EstimatorOptions& applied,
+                                           const std::vector<Sample>& log, const Calibration& cal) {
+  ContactEstimator est(model, GeometryModel{}, applied);
+  ASSERT_TRUE(est.reset(log.front()).ok());
+  VectorX sum2 = VectorX::Zero(model.nq());
+  int count = 0;
+  for (std::size_t k = 1; k < log.size(); ++k) {
+    ASSERT_TRUE(est.update(log[k]).ok());
+    if (log[k].t - log.front().t < 5.0 / 50.0 - 1e-9) continue;
+    sum2 += est.result().residual.cwiseAbs2();
+    ++count;
+  }
+  ASSERT_EQ(count, cal.samples_used);
+  for (int i = 0; i < model.nq(); ++i) {
+    EXPECT_NEAR(std::sqrt(sum2[i] / count), cal.joints[static_cast<std::size_t>(i)].rms_after, 1e-9)
+        << "joint " << i + 1;
+  }
+}
+
 // The residual filter (observer.residual_cutoff) through calibration: the thresholds and noise
 // are those of the filtered residual, exactly the one the estimator's detector sees; CALIB.yaml
 // carries the cutoff to the configuration that includes it; another cutoff there is refused; a
@@ -347,22 +368,10 @@ TEST(CalibrationFile, TheResidualFilterIsCalibratedAndCarriedWithItsThresholds) 
   const Calibration plain = calibrate(model, no_sensor(), log);
   Calibration cal = calibrate(model, options, log);
   EXPECT_EQ(cal.residual_cutoff, options.residual_cutoff);
-  // The estimator with the calibration applied: its residual's RMS over the samples used is the
-  // report's (the fit's residual through the same filter).
-  ContactEstimator est(model, GeometryModel{}, apply_calibration(options, cal));
-  ASSERT_TRUE(est.reset(log.front()).ok());
-  VectorX sum2 = VectorX::Zero(7);
-  int count = 0;
-  for (std::size_t k = 1; k < log.size(); ++k) {
-    ASSERT_TRUE(est.update(log[k]).ok());
-    if (log[k].t - log.front().t < 5.0 / 50.0 - 1e-9) continue;
-    sum2 += est.result().residual.cwiseAbs2();
-    ++count;
-  }
-  ASSERT_EQ(count, cal.samples_used);
+  // The estimator's residual is the fit's, through the same filter.
+  expect_estimator_residual_is_the_fits(model, apply_calibration(options, cal), log, cal);
   for (int i = 0; i < 7; ++i) {
     const auto j = static_cast<std::size_t>(i);
-    EXPECT_NEAR(std::sqrt(sum2[i] / count), cal.joints[j].rms_after, 1e-9) << "joint " << i + 1;
     if (i < 4) {
       EXPECT_LT(cal.joints[j].noise_std, 0.8 * plain.joints[j].noise_std) << "joint " << i + 1;
     } else {
@@ -432,21 +441,7 @@ TEST(CalibrationFile, TheInertiaCorrectionIsTheEstimatorsResidual) {
   EXPECT_GT(cal.joints[3].inertia_gain, 0.5);
   const EstimatorOptions applied = apply_calibration(no_sensor(), cal);
   EXPECT_EQ(applied.inertia_correction, cal.inertia_correction);
-  ContactEstimator est(model, GeometryModel{}, applied);
-  ASSERT_TRUE(est.reset(log.front()).ok());
-  VectorX sum2 = VectorX::Zero(7);
-  int count = 0;
-  for (std::size_t k = 1; k < log.size(); ++k) {
-    ASSERT_TRUE(est.update(log[k]).ok());
-    if (log[k].t - log.front().t < 5.0 / 50.0 - 1e-9) continue;
-    sum2 += est.result().residual.cwiseAbs2();
-    ++count;
-  }
-  ASSERT_EQ(count, cal.samples_used);
-  for (int i = 0; i < 7; ++i) {
-    EXPECT_NEAR(std::sqrt(sum2[i] / count), cal.joints[static_cast<std::size_t>(i)].rms_after, 1e-9)
-        << "joint " << i + 1;
-  }
+  expect_estimator_residual_is_the_fits(model, applied, log, cal);
   cal.source = "free.csv";
   const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_inertia";
   fs::create_directories(dir);
