@@ -346,8 +346,8 @@ void gravity_series(const Model& model, const std::vector<Sample>& samples, bool
   const int n = model.nq();
   const std::size_t N = samples.size();
   const std::size_t count = payload_columns ? 5 : 1;
-  std::array<Model, 5> models{model, model, model, model, model};
-  for (std::size_t c = 1; c < 5; ++c) {
+  std::vector<Model> models(count, model);
+  for (std::size_t c = 1; c < count; ++c) {
     Inertia unit;
     unit.mass = 1.0;
     if (c > 1) unit.com = Vector3::Unit(static_cast<Eigen::Index>(c - 2));

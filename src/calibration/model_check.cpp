@@ -77,6 +77,15 @@ std::string num(double x) {
   return b;
 }
 
+// "the robot's inertia along it is |δI| kg m^2 larger|smaller than the model's (why)".
+std::string inertia_size_and_sign(double delta) {
+  return "the robot's inertia along it is " + num(std::abs(delta)) + " kg m^2 " +
+         (delta > 0 ? "larger" : "smaller") + " than the model's (" +
+         (delta > 0 ? "a rotor inertia the model lacks"
+                    : "the model's link inertias are too large, or the torque lags the velocity") +
+         ")";
+}
+
 }  // namespace
 
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
@@ -123,34 +132,29 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     // Follows q̈: the calibrated residual against the filtered acceleration (central differences
     // of q̇). r = −δI q̈ when the robot's inertia along the joint exceeds the model's by δI (a
     // rotor inertia the model lacks; B's diagonal, so not a pure g(q) or friction pattern).
-    acc.assign(s.dq.size(), 0.0);
-    for (std::size_t k = 1; k + 1 < s.dq.size(); ++k)
-      acc[k] = (s.dq[k + 1] - s.dq[k - 1]) / (samples[k + 1].t - samples[k - 1].t);
-    // Beyond g(q): in a periodic motion the position, hence a gravity error, follows q̈ too.
-    filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
-    const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
-    const double delta = after[i].inertia != 0.0 ? after[i].inertia : -inertia.slope;
-    const std::string size_and_sign = "the robot's inertia along it is " + num(std::abs(delta)) +
-                                      " kg m^2 " + (delta > 0 ? "larger" : "smaller") +
-                                      " than the model's (" +
-                                      (delta > 0 ? "a rotor inertia the model lacks"
-                                                 : "the model's link inertias are too large, or "
-                                                   "the torque lags the velocity") +
-                                      ")";
     if (after[i].inertia != 0.0) {
       // Fitted with the friction (fit_joint): corrected in the observer's momentum.
-      check.patterns.push_back({"inertia", joint, after[i].inertia_gain,
-                                "joint " + std::to_string(joint) + ": " + size_and_sign +
-                                    "; corrected by observer.inertia_correction, which removes " +
-                                    num(100.0 * after[i].inertia_gain) +
-                                    " % of what friction leaves"});
-    } else if (inertia.extra_r2 >= kJointShare) {
       check.patterns.push_back(
-          {"inertia", joint, inertia.extra_r2,
-           "joint " + std::to_string(joint) +
-               ": the calibrated residual follows the joint's acceleration (R^2 " +
-               num(inertia.extra_r2) + " beyond g(q)): " + size_and_sign +
-               (delta > 0 ? "; armature: in the configuration" : "")});
+          {"inertia", joint, after[i].inertia_gain,
+           "joint " + std::to_string(joint) + ": " + inertia_size_and_sign(after[i].inertia) +
+               "; corrected by observer.inertia_correction, which removes " +
+               num(100.0 * after[i].inertia_gain) + " % of what friction leaves"});
+    } else {
+      acc.assign(s.dq.size(), 0.0);
+      for (std::size_t k = 1; k + 1 < s.dq.size(); ++k)
+        acc[k] = (s.dq[k + 1] - s.dq[k - 1]) / (samples[k + 1].t - samples[k - 1].t);
+      // Beyond g(q): in a periodic motion the position, hence a gravity error, follows q̈ too.
+      filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
+      const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
+      if (inertia.extra_r2 >= kJointShare) {
+        const double delta = -inertia.slope;
+        check.patterns.push_back(
+            {"inertia", joint, inertia.extra_r2,
+             "joint " + std::to_string(joint) +
+                 ": the calibrated residual follows the joint's acceleration (R^2 " +
+                 num(inertia.extra_r2) + " beyond g(q)): " + inertia_size_and_sign(delta) +
+                 (delta > 0 ? "; armature: in the configuration" : "")});
+      }
     }
     // Mostly above ~20 Hz (unfiltered joints only): the velocity's noise through K B(q), or the
     // torque's, which the residual filter removes (docs/estimator.md#residual-filter).

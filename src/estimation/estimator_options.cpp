@@ -35,8 +35,6 @@ void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   if (!(o.residual_cutoff.array() >= 0.0).all() || !o.residual_cutoff.allFinite()) {
     throw Error(where + ": observer.residual_cutoff: expected finite values >= 0 [Hz] (0: none)");
   }
-  if (!o.inertia_correction.allFinite())
-    throw Error(where + ": observer.inertia_correction: expected finite values [kg m^2]");
   if (!(o.solver.max_condition > 1.0) || !std::isfinite(o.solver.max_condition)) {
     throw Error(where + ": solver.max_condition: expected a finite value > 1");
   }
@@ -117,10 +115,7 @@ void validate(const EstimatorOptions& o, const Model& model) {
     throw Error(where + ": observer.residual_cutoff: expected 1 or " + std::to_string(n) +
                 " values, got " + std::to_string(o.residual_cutoff.size()));
   }
-  if (o.inertia_correction.size() != 1 && o.inertia_correction.size() != n) {
-    throw Error(where + ": observer.inertia_correction: expected 1 or " + std::to_string(n) +
-                " values, got " + std::to_string(o.inertia_correction.size()));
-  }
+  (void)MomentumObserver::checked_inertia_correction(o.inertia_correction, n);
   if (o.friction) validate_friction(*o.friction, n, "MomentumObserver");
   if (o.payload && !finite_inertia(o.payload->inertia)) {
     throw Error(where + ": payload: non-finite or negative mass properties");

@@ -173,8 +173,8 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
   const YAML::Node det = root["detection"];
   if (!root["friction"]) o.friction = cal.friction;
   // δI was fitted with the calibration's friction: taken with it, unless set here.
-  if (!root["friction"] && !(ob && ob["inertia_correction"]) && cal.inertia_correction.size() > 0)
-    o.inertia_correction = cal.inertia_correction;
+  if (!root["friction"] && !(ob && ob["inertia_correction"]))
+    o.inertia_correction = cal.inertia_correction;  // n values (zero where none was fitted)
   if (!(det && det["tau_min"])) o.detection.tau_min = cal.tau_threshold;
   // The speed term belongs to the calibration's τ_min: taken with it, unless set here.
   if (!(det && (det["tau_min"] || det["tau_per_speed"])))

@@ -61,14 +61,18 @@ void MomentumObserver::set_friction(const JointFriction& friction) {
   }
 }
 
-void MomentumObserver::set_inertia_correction(const VectorX& inertia_correction) {
-  if (inertia_correction.size() != 1 && inertia_correction.size() != n_) {
-    throw Error("MomentumObserver: inertia correction: expected 1 or " + std::to_string(n_) +
-                " values, got " + std::to_string(inertia_correction.size()));
+VectorX MomentumObserver::checked_inertia_correction(const VectorX& inertia_correction, int n) {
+  if (inertia_correction.size() != 1 && inertia_correction.size() != n) {
+    throw Error("MomentumObserver: observer.inertia_correction: expected 1 or " +
+                std::to_string(n) + " values, got " + std::to_string(inertia_correction.size()));
   }
   if (!inertia_correction.allFinite())
-    throw Error("MomentumObserver: inertia correction: expected finite values");
-  const VectorX delta = per_joint(inertia_correction, n_);
+    throw Error("MomentumObserver: observer.inertia_correction: expected finite values [kg m^2]");
+  return per_joint(inertia_correction, n);
+}
+
+void MomentumObserver::set_inertia_correction(const VectorX& inertia_correction) {
+  const VectorX delta = checked_inertia_correction(inertia_correction, n_);
   // The last momentum with the new δI: the next Δy contains no jump (as reanchor).
   if (initialized_) m_prev_ += (delta - inertia_correction_).cwiseProduct(dq_prev_);
   inertia_correction_ = delta;

@@ -167,10 +167,9 @@ struct Calibration {
                                           EstimatorOptions& options);
 
 /// The options with the calibration applied: friction, residual_cutoff, inertia_correction,
-/// detection.tau_min and
-/// tau_per_speed,
-/// (with a sensor) f_min and the sensor bias, and an identified payload (added to a configured
-/// one on the same body; throws extwrench::Error when the configured one is on another body).
+/// detection.tau_min and tau_per_speed, (with a sensor) f_min and the sensor bias, and an
+/// identified payload (added to a configured one on the same body; throws extwrench::Error when
+/// the configured one is on another body).
 [[nodiscard]] EstimatorOptions apply_calibration(EstimatorOptions options,
                                                  const Calibration& calibration);
 

@@ -60,8 +60,8 @@ struct EstimatorOptions {
   VectorX residual_cutoff = VectorX::Zero(1);
   /// δI [kg m² | kg], size 1 or n, finite, any sign: added to the momentum the observer
   /// differentiates, p = B(q) q̇ + δI q̇ (a constant error of the inertia along each joint,
-  /// identified by `extwrench calibrate`); 0: none. The residual only: q̈̂ and the base wrench
-  /// keep B(q) (docs/calibration.md#inertia-correction).
+  /// identified by `extwrench calibrate`), and to B(q)'s diagonal where q̈̂ is solved from the
+  /// residual (route (b)); 0: none (docs/calibration.md#inertia-correction).
   VectorX inertia_correction = VectorX::Zero(1);
   std::optional<JointFriction> friction;  ///< default: the model's Joint::damping / friction
   std::optional<PayloadOptions> payload;

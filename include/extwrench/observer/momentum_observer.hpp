@@ -51,6 +51,8 @@ class MomentumObserver {
   /// the current interval's integrand corrected like set_friction. Needs friction().offset of
   /// size n (set_friction with an offset first).
   void shift_offset(const Eigen::Ref<const VectorX>& delta) noexcept;
+  /// δI expanded to n entries; throws extwrench::Error unless size 1 or n and finite.
+  [[nodiscard]] static VectorX checked_inertia_correction(const VectorX& inertia_correction, int n);
   /// Sets δI (size n or 1, finite, any sign): the momentum becomes p = B(q) q̇ + δI q̇, a
   /// constant error of the inertia along each joint (calibration.hpp). Throws extwrench::Error
   /// on a bad size or value. Once initialized, the last momentum is corrected too (no jump).
