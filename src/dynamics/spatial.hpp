@@ -130,9 +130,8 @@ constexpr double kRoundShift = 6755399441055744.0;  // 1.5 * 2^52: x + it - it r
 /// random angles up to 10^6 rad): the nearest multiple k of pi/2 is removed in three parts
 /// (Cody-Waite; each k * part exact for |k| < 2^26), Cephes' minimax polynomials on
 /// [-pi/4, pi/4], the quadrant from k mod 4. |angle| > 2^20 rad, inf and NaN go to sin_cos.
-/// ~6 ns against ~11 ns for glibc's sincos here; gravity_torques, crba and rnea use it (the libm
-/// calls were a third of the gravity pass). The other passes keep sin_cos: their results stay
-/// bit for bit.
+/// ~6 ns against ~11 ns for glibc's sincos here; every pose pass uses it (the libm calls were a
+/// third of the gravity pass).
 
 inline void sin_cos_poly(double angle, double& s, double& c) {
   if (!(std::abs(angle) <= sin_cos_detail::kLargest)) {
@@ -205,13 +204,11 @@ inline Matrix3 axis_rotation(const Vector3& axis, double s, double c) {
   return out;
 }
 
-/// sin and cos of every joint coordinate into data.sin_q, data.cos_q, before a pose pass: the
-/// libm calls then run back to back, not inside the chain, where each call would push the pose
-/// and motion carried in registers out to the stack (every vector register is caller-saved)
-/// and reload them piecewise, which stalls store forwarding.
+/// sin and cos of every joint coordinate into data.sin_q, data.cos_q, before a pose pass, by
+/// sin_cos_poly_n (two angles per instruction, no libm call inside the chain, where each call
+/// would push the pose and motion carried in registers out to the stack).
 inline void joint_sin_cos(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
-  const int n = model.nq();
-  for (int j = 0; j < n; ++j) sin_cos(q[j], data.sin_q[j], data.cos_q[j]);
+  sin_cos_poly_n(q.data(), data.sin_q.data(), data.cos_q.data(), model.nq());
 }
 
 /// Pose (R, p) of body i and its joint's motion subspace S_i = [s_lin; s_ang] (world, about the
