@@ -18,23 +18,31 @@
 //   more than 50 ms after the last contact (0).
 //
 // Where a figure is not met, the case below says so with the bound it does meet and why.
+// The last test quantises the joint angles as a real arm's encoders do, and calibrates on a free
+// run first (docs/mujoco.md "Encoder quantisation").
 // In all: 10 contact episodes (the cases' minimum counts: 3, 2, 3, 2) on
 // links 4, 5, 6 and 7 of each robot.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "extwrench/app/replay.hpp"
 #include "extwrench/app/scenario_run.hpp"
 #include "extwrench/bridges/mjcf.hpp"
 #include "extwrench/bridges/mujoco_engine.hpp"
+#include "extwrench/calibration/calibration.hpp"
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/estimator_config.hpp"
+#include "extwrench/io/log.hpp"
 #include "extwrench/io/scenario_config.hpp"
 #include "support/scratch_dir.hpp"
 #include "support/text_files.hpp"
@@ -91,6 +99,11 @@ struct Episode {
 struct Figures {
   std::vector<Episode> episodes;
   int false_alarms = 0, free_samples = 0;
+  /// Contacts declared anew in a free phase (a rising edge 50 ms or more after MuJoCo's last
+  /// contact): false alarms proper, where `false_alarms` also counts a late release's samples.
+  int false_onsets = 0;
+  std::vector<double> false_onset_times, false_onset_gaps;  ///< t, and t − MuJoCo's last contact
+  double release = 0.0;  ///< longest time from an episode's last MuJoCo contact to the release
 };
 
 Figures measure(const fs::path& log_path, const fs::path& estimates_path) {
@@ -144,6 +157,9 @@ Figures measure(const fs::path& log_path, const fs::path& estimates_path) {
       e.force_error = std::sqrt(err2 / e.samples) / e.force_rms;
     }
     if (lines > 0) e.line_rms = std::sqrt(line2 / lines);
+    std::size_t released = last + 1;
+    while (released < n && declared(released)) ++released;
+    if (released < n) f.release = std::max(f.release, t[released] - t[last]);
     f.episodes.push_back(e);
     k = last + 1;
   }
@@ -156,6 +172,11 @@ Figures measure(const fs::path& log_path, const fs::path& estimates_path) {
     if (t[k] < 0.2 || t[k] - last_contact < 0.05) continue;
     ++f.free_samples;
     if (declared(k)) ++f.false_alarms;
+    if (declared(k) && (k == 0 || !declared(k - 1))) {
+      ++f.false_onsets;
+      f.false_onset_times.push_back(t[k]);
+      f.false_onset_gaps.push_back(t[k] - last_contact);
+    }
   }
   return f;
 }
@@ -196,19 +217,21 @@ class MujocoCollisions : public test::ScratchDirTest {
     const auto results = run_scenario(s, dir_, options);
     ASSERT_EQ(results.size(), 1U);
     int episodes = 0;
-    for (const char* scheme : {"ft", "none"}) {
+    for (const SchemeSpec& spec : s.schemes) {
+      const std::string& scheme = spec.name;
+      const bool base_sensor = scheme.starts_with("ft");  // ft, ft_k300: force and line checked
       const Figures f = measure(dir_ / "log.csv", dir_ / scheme / "estimates.csv");
       episodes = static_cast<int>(f.episodes.size());
-      std::printf("%s %s: %d free samples, %d false alarms\n", c.name.c_str(), scheme,
+      std::printf("%s %s: %d free samples, %d false alarms\n", c.name.c_str(), scheme.c_str(),
                   f.free_samples, f.false_alarms);
       EXPECT_EQ(f.false_alarms, 0) << c.name << " " << scheme;
       EXPECT_GT(f.free_samples, 500) << c.name;
       for (const Episode& e : f.episodes) {
         std::printf(
-            "  %-5s %6.3f-%6.3f s %-6s delay %5.1f ms, %4d samples, right link %5.1f %%, "
+            "  %-9s %6.3f-%6.3f s %-6s delay %5.1f ms, %4d samples, right link %5.1f %%, "
             "force error %5.1f %% of %6.1f N RMS, line RMS %s\n",
-            scheme, e.onset, e.end, e.links.c_str(), 1e3 * e.delay, e.samples, 100 * e.right_link,
-            100 * e.force_error, e.force_rms,
+            scheme.c_str(), e.onset, e.end, e.links.c_str(), 1e3 * e.delay, e.samples,
+            100 * e.right_link, 100 * e.force_error, e.force_rms,
             std::isnan(e.line_rms) ? "-" : (std::to_string(1e3 * e.line_rms) + " mm").c_str());
         const auto bound = [&](const std::string& figure, double acceptance) {
           for (const Exception& x : c.exceptions) {
@@ -221,7 +244,7 @@ class MujocoCollisions : public test::ScratchDirTest {
         EXPECT_LE(e.delay, bound("delay", 0.030) + 1e-9) << where;
         ASSERT_GT(e.samples, 20) << where;
         EXPECT_GE(e.right_link, bound("right_link", 0.95)) << where;
-        if (std::string(scheme) == "ft") {
+        if (base_sensor) {
           EXPECT_LE(e.force_error, bound("force_error", 0.05)) << where;
           EXPECT_LE(e.line_rms, bound("line", 0.01)) << where;
         }
@@ -347,9 +370,11 @@ TEST_F(MujocoCollisions, PaperArmSwingsIntoTwoBoxes) {
        false,
        3,
        {{"ft", "link7", "force_error", 0.13,
-         "13.6 N RMS on the post's top edge: F̂ from the base sensor inherits the residual's lag "
-         "(docs/estimator.md 'Lag'), 11.5 % measured; the differentiation route measured worse"},
-        {"ft", "link7", "line", 0.008, "the same lag tilts the line: 7.2 mm measured"},
+         "13.6 N RMS on the post's top edge, where MuJoCo's contact chatters: 23 of the 461 "
+         "samples have no contact, the force jumps 4.4 N RMS from one sample to the next. The "
+         "truth low-passed at K = 100 s^-1 is itself 9.1 % off it (7 % at 1000 s^-1); 11.5 % "
+         "measured, and more with a higher gain (12.6 % at K = 200, 14.1 % at 300)"},
+        {"ft", "link7", "line", 0.008, "the same chatter moves the line: 7.2 mm measured"},
         {"none", "link5", "right_link", 0.0,
          "the shelf's force on link5 passes through joint 5's axis (along the forearm): joints "
          "5-7 feel nothing and the residual names link4; 0 % measured (ft: 99.7 %)"}}});
@@ -380,6 +405,114 @@ TEST_F(MujocoCollisions, PandaHitByAMovingCapsule) {
          "a 75 ms impact (44 N RMS): most of its 26 samples lie in the residual's transient; "
          "6.7 % measured"},
         {"ft", "link4", "line", 0.019, "18.3 mm measured, the same transient"}}});
+}
+
+// A real arm's joint angles are quantised: 2π/2^19 rad here (19-bit encoders), q̇ the backward
+// difference through a 100 Hz low-pass (the scenario's `sensors.encoder`), and the F/T sensor
+// has 0.1 N / 0.005 N m of noise. K B(q) turns that q̇ noise into up to ~1 N m of residual, so
+// the defaults of the tests above false-alarm. The remedy is the procedure a user follows before
+// the robot (docs/calibration.md): record a contact-free motion with the same sensors (here in
+// MuJoCo: the scene without its obstacles, every joint moving, another seed: another model error
+// and noise), calibrate on it, estimate with the calibration. The free run's model is the
+// estimator's on both runs (the one the user has). `calibrate` names the filter itself (its
+// model check: the residual's variance lies above ~20 Hz), so the observer low-passes at 20 Hz.
+constexpr double kReboundWindow = 0.25;  // [s] after a contact: the arm's spring-back
+
+void quantise(Scenario& s) {
+  s.simulation.encoder.resolution = 2.0 * std::numbers::pi / (1 << 19);
+  s.simulation.encoder.differentiate = true;
+  s.simulation.encoder.velocity_cutoff = 100.0;
+  s.simulation.sensor.force_noise_S.setConstant(0.1);
+  s.simulation.sensor.moment_noise_S.setConstant(0.005);
+}
+
+TEST_F(MujocoCollisions, PandaCalibratedOnAFreeRunUnderEncoderQuantisation) {
+  if (!fs::exists(EXTWRENCH_SHARED_DIR "/models/franka_panda")) {
+    GTEST_SKIP() << "shared models absent: " << EXTWRENCH_SHARED_DIR;
+  }
+  RunOptions run_options;
+  run_options.figures = false;
+  std::ostringstream messages;
+  run_options.messages = &messages;
+  Scenario free = load_scenario(kData / "panda_boxes.yaml");
+  quantise(free);
+  free.obstacles.clear();
+  free.seeds = {2};
+  free.simulation.duration = 20.0;
+  free.trajectory.amplitude << 0.9, 0.25, 0.4, 0.3, 0.5, 0.4, 0.6;
+  free.trajectory.frequency << 0.2, 0.13, 0.17, 0.11, 0.23, 0.19, 0.29;
+  free.schemes = {
+      {"ft", "{sensor: {type: ft}, observer: {gain: 100, residual_cutoff: 20}}", 0},
+      {"none", "{sensor: {type: none}, observer: {gain: 100, residual_cutoff: 20}}", 0}};
+  (void)run_scenario(free, dir_ / "free", run_options);
+  ASSERT_EQ(
+      measure(dir_ / "free" / "log.csv", dir_ / "free" / "ft" / "estimates.csv").episodes.size(),
+      0U)
+      << "the free run touches something";
+  for (const char* scene : {"panda_boxes", "panda_person"}) {
+    Scenario hit = load_scenario(kData / (std::string(scene) + ".yaml"));
+    quantise(hit);
+    const fs::path dir = dir_ / scene;
+    (void)run_scenario(hit, dir, run_options);  // its schemes: the defaults (K = 100, no filter)
+    for (const char* scheme : {"ft", "none"}) {
+      const EstimatorConfig cfg = load_estimator_config(dir_ / "free" / scheme / "config.yaml");
+      std::vector<Sample> samples;
+      LogReader reader(dir_ / "free" / "log.csv", cfg.robot.model);
+      for (Sample s; reader.next(s);) samples.push_back(s);
+      const Calibration cal = calibrate(cfg.robot.model, cfg.options, samples);
+      ReplayOptions replay;
+      replay.log = dir / "log.csv";
+      replay.out_dir = dir / (std::string(scheme) + "_calibrated");
+      replay.figures = false;
+      replay.messages = &messages;
+      (void)replay_log(cfg.robot.model, cfg.robot.geometry, apply_calibration(cfg.options, cal),
+                       replay);
+      const Figures defaults = measure(dir / "log.csv", dir / scheme / "estimates.csv");
+      const Figures f = measure(dir / "log.csv", replay.out_dir / "estimates.csv");
+      std::printf(
+          "%s %s, quantised: defaults %d false-alarm samples (%d onsets) of %d; calibrated %d "
+          "(%d onsets), release within %.0f ms of the last contact\n",
+          scene, scheme, defaults.false_alarms, defaults.false_onsets, defaults.free_samples,
+          f.false_alarms, f.false_onsets, 1e3 * f.release);
+      const auto print_onsets = [](const char* who, const Figures& g) {
+        for (std::size_t i = 0; i < g.false_onset_times.size(); ++i) {
+          std::printf("  %s: false onset at %.3f s, ", who, g.false_onset_times[i]);
+          if (g.false_onset_gaps[i] > 1e6) {
+            std::printf("before any contact\n");
+          } else {
+            std::printf("%.0f ms after the last contact\n", 1e3 * g.false_onset_gaps[i]);
+          }
+        }
+      };
+      print_onsets("defaults", defaults);
+      print_onsets("calibrated", f);
+      const std::string where = std::string(scene) + " " + scheme;
+      EXPECT_GT(defaults.false_alarms, 0) << where << ": the defaults stay quiet; no test here";
+      EXPECT_LE(f.false_onsets, defaults.false_onsets) << where;
+      // The one false onset left in each scene comes 90-160 ms after a push ends: the arm springs
+      // back with accelerations 2-10 times the free run's largest, whose 1 % model error the
+      // thresholds (set for the free run's motion) do not cover. None further from a contact.
+      int rebound_onsets = 0;
+      for (double gap : f.false_onset_gaps) {
+        EXPECT_LT(gap, kReboundWindow) << where << " at " << gap << " s after a contact";
+        if (gap < kReboundWindow) ++rebound_onsets;
+      }
+      EXPECT_LE(rebound_onsets, 1) << where;
+      EXPECT_LE(f.release, 0.15) << where;
+      for (const Episode& e : f.episodes) {
+        std::printf(
+            "  %-4s %6.3f-%6.3f s %-6s delay %5.1f ms, right link %5.1f %%, force error %5.1f "
+            "%%, line RMS %.1f mm\n",
+            scheme, e.onset, e.end, e.links.c_str(), 1e3 * e.delay, 100 * e.right_link,
+            100 * e.force_error, 1e3 * e.line_rms);
+        const std::string at = where + " " + e.links + " at " + std::to_string(e.onset) + " s";
+        EXPECT_LE(e.delay, 0.030) << at;
+        // As above: with no sensor the shelf's force on link5 passes joint 5's axis.
+        if (std::string(scheme) == "none" && e.links == "link5") continue;
+        EXPECT_GE(e.right_link, 0.95) << at;
+      }
+    }
+  }
 }
 
 }  // namespace
