@@ -175,6 +175,18 @@ void register_contact_benchmarks() {
           run_update(state, arm.model, arm.geometry, o, link6);
         });
   }
+  // Thresholds that also follow the dynamic torque (detection.inertial_margin): τ_dyn and its
+  // share, against the speed thresholds above. c is small so that the contact stays declared.
+  for (const Config& c : {kTableI[0], kTableI[4]}) {
+    benchmark::RegisterBenchmark(
+        (std::string("BM_FullUpdate_Ours/") + c.name + "/capsules/inertial_margin").c_str(),
+        [&arm, &link6, c](benchmark::State& state) {
+          EstimatorOptions o = options_for(c, link6);
+          o.detection.tau_per_speed = VectorX::Constant(1, 0.01);
+          o.detection.inertial_margin = VectorX::Constant(1, 0.01);
+          run_update(state, arm.model, arm.geometry, o, link6);
+        });
+  }
   // The residual filter (observer.residual_cutoff, 20 Hz on every joint): its per-sample cost
   // against the plain update above in the same binary.
   for (const Config& c : {kTableI[0], kTableI[4]}) {

@@ -73,6 +73,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
   b_ = VectorX::Zero(n_);
   tau_pred_ = VectorX::Zero(n_);
   tau_eff_ = VectorX::Zero(n_);
+  dynamic_torque_ = VectorX::Zero(n_);
   J_ = Matrix6X::Zero(6, n_);
   root_wrench_dddq_ = Matrix6X::Zero(6, n_);
   minv_jvt_r_.setZero(n_, 4);
@@ -381,7 +382,14 @@ void ContactEstimator::estimate(double t, const Eigen::Ref<const VectorX>& dq,
   const ReleaseForces release = has_sensor && !base.taring && release_link_ >= 0
                                     ? sensor_release_forces(base)
                                     : ReleaseForces{};
-  detector_.set_motion(dq);  // thresholds that follow |q̇| (no-op when constant)
+  // Thresholds that follow |q̇| and |τ_dyn| (no-op when constant). τ_dyn = τ − τ_f − g + τ̂_ext
+  // needs stage 1's g: not after update_with, whose caller gave q̈̂ (there only |q̇|).
+  if (detector_.inertia_dependent() && !ddq_supplied_) {
+    dynamic_torque_ = tau_eff_ - data_.gravity_torque + tau_ext_;
+    detector_.set_motion(dq, dynamic_torque_);
+  } else {
+    detector_.set_motion(dq);
+  }
   const DetectionResult& det =
       detector_.update(t, tau_ext_, base_force, release.either, release.measured);
   out_.contact = det.contact;

@@ -35,6 +35,17 @@ void validate(const DetectionOptions& options, int n) {
                   "]: expected a finite value >= 0 [N m s/rad]");
     }
   }
+  const VectorX& c = options.inertial_margin;
+  if (c.size() != 0 && c.size() != 1 && c.size() != n) {
+    throw Error("detection.inertial_margin: expected 1 or " + std::to_string(n) + " values, got " +
+                std::to_string(c.size()));
+  }
+  for (Eigen::Index i = 0; i < c.size(); ++i) {
+    if (!std::isfinite(c[i]) || c[i] < 0.0) {
+      throw Error("detection.inertial_margin[" + std::to_string(i) +
+                  "]: expected a finite value >= 0 (a fraction of the joint's dynamic torque)");
+    }
+  }
   if (!std::isfinite(options.f_min) || !(options.f_min > 0.0)) {
     throw Error("detection.f_min: expected a finite value > 0");
   }
@@ -57,6 +68,9 @@ ContactDetector::ContactDetector(const DetectionOptions& options, int n, double 
   const VectorX& b = options.tau_per_speed;
   tau_speed_ = b.size() == 0 ? VectorX::Zero(n) : per_joint(b, n);
   speed_dependent_ = (tau_speed_.array() > 0.0).any();
+  const VectorX& c = options.inertial_margin;
+  margin_ = c.size() == 0 ? VectorX::Zero(n) : per_joint(c, n);
+  inertia_dependent_ = (margin_.array() > 0.0).any();
   threshold_ = tau_min_;
   joint_over_.setConstant(n, false);
 }
@@ -64,6 +78,16 @@ ContactDetector::ContactDetector(const DetectionOptions& options, int n, double 
 void ContactDetector::set_motion(const Eigen::Ref<const VectorX>& dq) noexcept {
   if (!speed_dependent_) return;
   threshold_.array() = tau_min_.array() + tau_speed_.array() * dq.array().abs();
+}
+
+void ContactDetector::set_motion(const Eigen::Ref<const VectorX>& dq,
+                                 const Eigen::Ref<const VectorX>& dynamic_torque) noexcept {
+  if (!inertia_dependent_) {
+    set_motion(dq);
+    return;
+  }
+  threshold_.array() = tau_min_.array() + tau_speed_.array() * dq.array().abs() +
+                       margin_.array() * dynamic_torque.array().abs();
 }
 
 void ContactDetector::reset() noexcept {

@@ -69,13 +69,16 @@ void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorO
 
 void read_detection(const YamlReader& rd, const YAML::Node& d, int n, DetectionOptions& o) {
   rd.only_keys(d, "detection",
-               {"tau_min", "tau_per_speed", "f_min", "release_ratio", "min_duration",
-                "sensor_release_duration"});
+               {"tau_min", "tau_per_speed", "inertial_margin", "f_min", "release_ratio",
+                "min_duration", "sensor_release_duration"});
   const Range tau_min = positive();
   if (d["tau_min"]) o.tau_min = rd.vector(d["tau_min"], "detection.tau_min", n, &tau_min);
   const Range per_speed = io_detail::non_negative(">= 0 [N m s/rad]");
   if (d["tau_per_speed"])
     o.tau_per_speed = rd.vector(d["tau_per_speed"], "detection.tau_per_speed", n, &per_speed);
+  const Range margin = io_detail::non_negative(">= 0 (a fraction of the dynamic torque)");
+  if (d["inertial_margin"])
+    o.inertial_margin = rd.vector(d["inertial_margin"], "detection.inertial_margin", n, &margin);
   rd.set_number_in(d, "detection", "f_min", {0, 1e12, true, "> 0 [N]"}, o.f_min);
   rd.set_number_in(d, "detection", "release_ratio", {0, 1, true, "in (0, 1]"}, o.release_ratio);
   rd.set_number_in(d, "detection", "min_duration", {0, 1e6, false, ">= 0 [s]"}, o.min_duration);
@@ -439,6 +442,8 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min);
   if ((o.detection.tau_per_speed.array() > 0.0).any())
     y << "\n  tau_per_speed: " << io_detail::yaml_list(o.detection.tau_per_speed);
+  if ((o.detection.inertial_margin.array() > 0.0).any())
+    y << "\n  inertial_margin: " << io_detail::yaml_list(o.detection.inertial_margin);
   y << "\n  f_min: " << o.detection.f_min << "\n  release_ratio: " << o.detection.release_ratio
     << "\n  min_duration: " << o.detection.min_duration
     << "\n  sensor_release_duration: " << o.detection.sensor_release_duration << '\n';

@@ -3,10 +3,14 @@
 // residual contradicts (the force is still there) is undone and not repeated.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/dynamics/rnea.hpp"
+#include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/estimation/detection.hpp"
+#include "support/test_robots.hpp"
 
 namespace extwrench {
 namespace {
@@ -131,6 +135,97 @@ TEST(Detection, SpeedThresholdOptionsAreValidated) {
   EXPECT_THROW(validate(options, kJoints), Error);
   options.tau_per_speed = VectorX::Constant(1, 0.1);
   EXPECT_NO_THROW(validate(options, kJoints));
+}
+
+// The inertial margin (docs/calibration.md#thresholds-that-follow-the-motion): τ_thr,i =
+// τ_min,i + b_i |q̇_i| + c_i |τ_dyn,i|, the same residual over while the arm coasts and under
+// while it is accelerated hard.
+TEST(Detection, InertialMarginRisesWithTheDynamicTorque) {
+  DetectionOptions options;
+  options.tau_min = VectorX::Constant(kJoints, 1.0);
+  options.tau_per_speed = VectorX::Constant(1, 2.0);
+  options.inertial_margin = VectorX::Constant(kJoints, 0.05);
+  options.min_duration = 0.0;
+  ContactDetector detector(options, kJoints);
+  EXPECT_TRUE(detector.inertia_dependent());
+  VectorX tau_ext = VectorX::Zero(kJoints);
+  tau_ext[2] = 2.0;
+  VectorX dq = VectorX::Zero(kJoints);
+  dq[2] = 0.25;  // 1 + 2 · 0.25 = 1.5 N m from the speed
+  VectorX dynamic = VectorX::Zero(kJoints);
+  dynamic[2] = -20.0;  // + 0.05 · 20 = 2.5 N m
+  dynamic[0] = 4.0;
+  detector.set_motion(dq, dynamic);
+  EXPECT_DOUBLE_EQ(detector.thresholds()[2], 2.5);
+  EXPECT_DOUBLE_EQ(detector.thresholds()[0], 1.2);
+  EXPECT_DOUBLE_EQ(detector.thresholds()[1], 1.0);
+  EXPECT_FALSE(detector.update(0.0, tau_ext, NAN).raw);
+  dynamic[2] = 5.0;  // 1.75 N m: 2 N m is over
+  detector.set_motion(dq, dynamic);
+  EXPECT_DOUBLE_EQ(detector.thresholds()[2], 1.75);
+  EXPECT_TRUE(detector.update(kDt, tau_ext, NAN).contact);
+  // set_motion(q̇) alone: the speed part only.
+  detector.set_motion(dq);
+  EXPECT_DOUBLE_EQ(detector.thresholds()[2], 1.5);
+  // Without a margin the dynamic torque changes nothing.
+  options.inertial_margin.resize(0);
+  ContactDetector speed_only(options, kJoints);
+  EXPECT_FALSE(speed_only.inertia_dependent());
+  speed_only.set_motion(dq, dynamic);
+  EXPECT_DOUBLE_EQ(speed_only.thresholds()[2], 1.5);
+}
+
+TEST(Detection, InertialMarginOptionsAreValidated) {
+  DetectionOptions options;
+  options.inertial_margin = VectorX::Constant(2, 0.01);
+  EXPECT_THROW(validate(options, kJoints), Error);
+  options.inertial_margin = VectorX::Constant(1, -0.01);
+  EXPECT_THROW(validate(options, kJoints), Error);
+  options.inertial_margin = VectorX::Constant(1, NAN);
+  EXPECT_THROW(validate(options, kJoints), Error);
+  options.inertial_margin = VectorX::Constant(kJoints, 0.01);
+  EXPECT_NO_THROW(validate(options, kJoints));
+}
+
+// In the estimator τ_dyn is τ − τ_f − g(q) + τ̂_ext = B q̈ + C q̇ (the torque that accelerates
+// the arm): its thresholds after every sample against g(q) from gravity_torques (the body-frame
+// pass, not the estimator's world-frame momentum pass) and the residual it reports.
+TEST(Detection, TheEstimatorsInertialMarginUsesTheDynamicTorque) {
+  const Model model = test::paper_arm_model();
+  const int n = model.nq();
+  EstimatorOptions options;
+  options.sensor.type = SensorType::kNone;
+  options.friction = JointFriction::none(n);
+  options.detection.tau_min = VectorX::Constant(1, 1.0);
+  options.detection.inertial_margin = VectorX::LinSpaced(n, 0.01, 0.07);
+  ContactEstimator estimator(model, GeometryModel{}, options);
+  Data data(model);
+  VectorX q(n), dq(n), tau(n);
+  const auto state = [&](double t) {
+    for (int i = 0; i < n; ++i) {
+      q[i] = 0.3 * std::sin(2.0 * t + i);
+      dq[i] = 0.6 * std::cos(2.0 * t + i);
+    }
+    // Gravity plus a torque that accelerates the arm (not its true dynamics: the relation under
+    // test holds for any input).
+    tau =
+        gravity_torques(model, data, q) + 5.0 * VectorX::LinSpaced(n, 1.0, -1.0) * std::sin(9 * t);
+  };
+  state(0.0);
+  ASSERT_TRUE(estimator.reset(0.0, q, dq, tau).ok());
+  double largest = 0.0;
+  for (int k = 1; k <= 300; ++k) {
+    const double t = k * kDt;
+    state(t);
+    ASSERT_TRUE(estimator.update(t, q, dq, tau).ok());
+    const VectorX dynamic = tau - gravity_torques(model, data, q) + estimator.result().residual;
+    for (int i = 0; i < n; ++i) {
+      const double expected = 1.0 + options.detection.inertial_margin[i] * std::abs(dynamic[i]);
+      EXPECT_NEAR(estimator.detector().thresholds()[i], expected, 1e-12) << "joint " << i + 1;
+      largest = std::max(largest, expected - 1.0);
+    }
+  }
+  EXPECT_GT(largest, 0.1);  // the margin did move the thresholds
 }
 
 }  // namespace

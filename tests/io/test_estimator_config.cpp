@@ -28,6 +28,8 @@ TEST(EstimatorConfig, ReadsEveryKeyOfAFullFile) {
   EXPECT_EQ(o.observer_gain.size(), 7);
   EXPECT_EQ(o.observer_gain[3], 120.0);
   EXPECT_EQ(o.detection.tau_min[6], 0.3);
+  ASSERT_EQ(o.detection.inertial_margin.size(), 7);
+  EXPECT_EQ(o.detection.inertial_margin[5], 0.05);
   EXPECT_EQ(o.detection.f_min, 4.0);
   EXPECT_EQ(o.detection.release_ratio, 0.6);
   EXPECT_EQ(o.detection.min_duration, 0.004);
@@ -128,6 +130,7 @@ TEST(EstimatorConfig, WrittenConfigReadsBackToTheSameOptions) {
     EXPECT_EQ(x.observer_gain.minCoeff(), y.observer_gain.minCoeff()) << file;
     EXPECT_EQ(x.observer_gain.maxCoeff(), y.observer_gain.maxCoeff()) << file;
     EXPECT_EQ(x.detection.f_min, y.detection.f_min) << file;
+    EXPECT_EQ(x.detection.inertial_margin, y.detection.inertial_margin) << file;
     EXPECT_EQ(x.detection.release_ratio, y.detection.release_ratio) << file;
     EXPECT_EQ(x.detection.min_duration, y.detection.min_duration) << file;
     EXPECT_EQ(x.detection.sensor_release_duration, y.detection.sensor_release_duration) << file;
@@ -208,6 +211,10 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"sensor: {type: ft}\ndetection:\n  sensor_release_duration: soon\n",
                   ":4:", "detection.sensor_release_duration", "finite number"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: 0\n", ":4:", "detection.f_min", "> 0"},
+        BadConfig{"sensor: {type: none}\ndetection:\n  inertial_margin: -0.01\n",
+                  ":4:", "detection.inertial_margin", ">= 0"},
+        BadConfig{"sensor: {type: none}\ndetection:\n  inertial_margin: [0.01, 0.02]\n",
+                  ":4:", "detection.inertial_margin", "7 values"},
         BadConfig{"sensor: {type: ft}\nisolation:\n  misfit_margin: -1\n",
                   ":4:", "isolation.misfit_margin", ">= 0"},
         BadConfig{"sensor: {type: ft}\ndetection:\n  f_min: inf\n", ":4:", "detection.f_min",

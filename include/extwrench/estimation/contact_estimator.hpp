@@ -180,6 +180,7 @@ class ContactEstimator {
 
   // Scratch, sized once.
   VectorX ddq_, tau_ext_, b_, tau_pred_, tau_eff_;
+  VectorX dynamic_torque_;  ///< τ_dyn = τ − τ_f − g + τ̂_ext, for thresholds that follow it
   Matrix6X J_;
   /// ∂f_0/∂q̈ (6×n): column j−1 = Ic_j S_j, the root wrench per unit q̈_j (stage 4, route (b));
   /// the release force's G, H. Valid for this sample when root_wrench_dddq_valid_.

@@ -28,6 +28,10 @@ struct DetectionOptions {
   VectorX tau_min = VectorX::Constant(1, 1.0);  ///< τ_min [N m | N]: size 1 (all joints) or n
   /// b ≥ 0 of τ_thr,i = τ_min,i + b_i |q̇_i| [N m s/rad]: size 0 (none), 1 (all joints) or n.
   VectorX tau_per_speed;
+  /// c ≥ 0 adding c_i |τ_dyn,i| to τ_thr,i: τ_dyn = τ − τ_f − g(q) + τ̂_ext = B q̈ + C q̇ is the
+  /// torque that accelerates the arm, c the model's relative inertia error, whose residual grows
+  /// with it (docs/calibration.md, "The inertial margin"). Size 0 (none), 1 or n.
+  VectorX inertial_margin;
   double f_min = 5.0;           ///< F_min on ‖F̂_ext‖ from the base sensor [N]
   double release_ratio = 0.5;   ///< off level = ratio × on level, in (0, 1]
   double min_duration = 0.005;  ///< [s] ≥ 0, for both onset and release
@@ -63,6 +67,9 @@ class ContactDetector {
   /// The thresholds for the current joint velocities: τ_thr = τ_min + b ∘ |q̇| (no-op without
   /// tau_per_speed). Call before update() with the sample's q̇ (finite, size n). No allocation.
   void set_motion(const Eigen::Ref<const VectorX>& dq) noexcept;
+  /// The same plus c ∘ |τ_dyn| (inertial_margin; τ_dyn finite, size n). No allocation.
+  void set_motion(const Eigen::Ref<const VectorX>& dq,
+                  const Eigen::Ref<const VectorX>& dynamic_torque) noexcept;
   /// τ̂_ext (n) and ‖F̂_ext‖ (NaN when there is no usable base force) at time t. No allocation.
   /// release_force_norm: the sensor's instantaneous force (docs/estimator.md#release-from-the-
   /// sensor), NaN when unknown. When finite, a declared contact is released once it falls below
@@ -87,14 +94,18 @@ class ContactDetector {
   [[nodiscard]] const VectorX& tau_min() const noexcept { return threshold_; }
   /// Whether the thresholds follow |q̇| (tau_per_speed given and not all zero).
   [[nodiscard]] bool speed_dependent() const noexcept { return speed_dependent_; }
+  /// Whether they follow |τ_dyn| (inertial_margin given and not all zero).
+  [[nodiscard]] bool inertia_dependent() const noexcept { return inertia_dependent_; }
   [[nodiscard]] const DetectionOptions& options() const noexcept { return options_; }
 
  private:
   DetectionOptions options_;
   VectorX tau_min_;    ///< a: constant part (n)
   VectorX tau_speed_;  ///< b: per |q̇| (n; zero when constant)
+  VectorX margin_;     ///< c: per |τ_dyn| (n; zero when none)
   VectorX threshold_;  ///< τ_thr in force (n)
   bool speed_dependent_ = false;
+  bool inertia_dependent_ = false;
   Eigen::Matrix<bool, Eigen::Dynamic, 1> joint_over_;
   bool base_over_ = false;
   bool declared_ = false;
