@@ -10,6 +10,20 @@ namespace extwrench {
 namespace {
 // Time stamps are sums of floating steps: a duration reached up to this slack counts as reached.
 constexpr double kTimeSlack = 1e-9;  // [s]
+
+// The factor of a threshold term that follows the motion (tau_per_speed, inertial_margin): none,
+// one for all joints or one per joint, each finite and >= 0.
+void check_optional_slopes(const VectorX& values, const std::string& key, const char* unit, int n) {
+  if (values.size() != 0 && values.size() != 1 && values.size() != n) {
+    throw Error(key + ": expected 1 or " + std::to_string(n) + " values, got " +
+                std::to_string(values.size()));
+  }
+  for (Eigen::Index i = 0; i < values.size(); ++i) {
+    if (!std::isfinite(values[i]) || values[i] < 0.0) {
+      throw Error(key + "[" + std::to_string(i) + "]: expected a finite value >= 0 " + unit);
+    }
+  }
+}
 }  // namespace
 
 void validate(const DetectionOptions& options, int n) {
@@ -24,28 +38,9 @@ void validate(const DetectionOptions& options, int n) {
       throw Error("detection.tau_min[" + std::to_string(i) + "]: expected a finite value > 0");
     }
   }
-  const VectorX& b = options.tau_per_speed;
-  if (b.size() != 0 && b.size() != 1 && b.size() != n) {
-    throw Error("detection.tau_per_speed: expected 1 or " + std::to_string(n) + " values, got " +
-                std::to_string(b.size()));
-  }
-  for (Eigen::Index i = 0; i < b.size(); ++i) {
-    if (!std::isfinite(b[i]) || b[i] < 0.0) {
-      throw Error("detection.tau_per_speed[" + std::to_string(i) +
-                  "]: expected a finite value >= 0 [N m s/rad]");
-    }
-  }
-  const VectorX& c = options.inertial_margin;
-  if (c.size() != 0 && c.size() != 1 && c.size() != n) {
-    throw Error("detection.inertial_margin: expected 1 or " + std::to_string(n) + " values, got " +
-                std::to_string(c.size()));
-  }
-  for (Eigen::Index i = 0; i < c.size(); ++i) {
-    if (!std::isfinite(c[i]) || c[i] < 0.0) {
-      throw Error("detection.inertial_margin[" + std::to_string(i) +
-                  "]: expected a finite value >= 0 (a fraction of the joint's dynamic torque)");
-    }
-  }
+  check_optional_slopes(options.tau_per_speed, "detection.tau_per_speed", "[N m s/rad]", n);
+  check_optional_slopes(options.inertial_margin, "detection.inertial_margin",
+                        "(a fraction of the joint's dynamic torque)", n);
   if (!std::isfinite(options.f_min) || !(options.f_min > 0.0)) {
     throw Error("detection.f_min: expected a finite value > 0");
   }
