@@ -2,8 +2,8 @@
 // with hysteresis and a minimum duration.
 //
 //  - joint i is "over" when |τ̂_ext,i| > τ_thr,i and stays over until |τ̂_ext,i| < ratio · τ_thr,i,
-//    with τ_thr,i = τ_min,i + b_i |q̇_i| (b = tau_per_speed, docs/calibration.md; 0 by default:
-//    a constant threshold);
+//    with τ_thr,i = τ_min,i + b_i |q̇_i| + c_i |τ_dyn,i| (b = tau_per_speed, c =
+//    inertial_margin, docs/calibration.md; 0 by default: a constant threshold);
 //    the base force likewise with ‖F̂_ext‖ and F_min (release level = release_ratio × on level);
 //  - the raw detection is "any joint or the base force over"; a contact is declared once the raw
 //    detection has held for min_duration seconds and released once it has been off for
@@ -87,7 +87,8 @@ class ContactDetector {
                                 double measured_release_force_norm = kNoReleaseForce) noexcept;
   static constexpr double kNoReleaseForce = std::numeric_limits<double>::quiet_NaN();
   [[nodiscard]] const DetectionResult& result() const noexcept { return result_; }
-  /// The joint thresholds in force: τ_min + b ∘ |q̇| at the last set_motion (τ_min when constant).
+  /// The joint thresholds in force: τ_min + b ∘ |q̇| (+ c ∘ |τ_dyn|) at the last set_motion
+  /// (τ_min when constant).
   [[nodiscard]] const VectorX& thresholds() const noexcept { return threshold_; }
   /// The same as thresholds() (its name from before the thresholds followed |q̇|; kept for
   /// compatibility: it returns τ_min + b ∘ |q̇|, not options().tau_min).
