@@ -127,14 +127,23 @@ TEST(Detection, SpeedThresholdsRiseWithTheJointSpeed) {
   EXPECT_DOUBLE_EQ(constant.tau_min()[2], 1.0);
 }
 
-TEST(Detection, SpeedThresholdOptionsAreValidated) {
-  DetectionOptions options;
-  options.tau_per_speed = VectorX::Constant(2, 0.1);
-  EXPECT_THROW(validate(options, kJoints), Error);
-  options.tau_per_speed = VectorX::Constant(1, -0.1);
-  EXPECT_THROW(validate(options, kJoints), Error);
-  options.tau_per_speed = VectorX::Constant(1, 0.1);
-  EXPECT_NO_THROW(validate(options, kJoints));
+// The factors of the terms that follow the motion, b (tau_per_speed) and c (inertial_margin):
+// none, one or n of them, each finite and >= 0.
+TEST(Detection, MotionThresholdFactorsAreValidated) {
+  for (VectorX DetectionOptions::*factor :
+       {&DetectionOptions::tau_per_speed, &DetectionOptions::inertial_margin}) {
+    DetectionOptions options;
+    options.*factor = VectorX::Constant(2, 0.1);
+    EXPECT_THROW(validate(options, kJoints), Error);
+    options.*factor = VectorX::Constant(1, -0.1);
+    EXPECT_THROW(validate(options, kJoints), Error);
+    options.*factor = VectorX::Constant(1, NAN);
+    EXPECT_THROW(validate(options, kJoints), Error);
+    options.*factor = VectorX::Constant(1, 0.1);
+    EXPECT_NO_THROW(validate(options, kJoints));
+    options.*factor = VectorX::Constant(kJoints, 0.01);
+    EXPECT_NO_THROW(validate(options, kJoints));
+  }
 }
 
 // The inertial margin (docs/calibration.md#thresholds-that-follow-the-motion): τ_thr,i =
@@ -173,18 +182,6 @@ TEST(Detection, InertialMarginRisesWithTheDynamicTorque) {
   EXPECT_FALSE(speed_only.inertia_dependent());
   speed_only.set_motion(dq, dynamic);
   EXPECT_DOUBLE_EQ(speed_only.thresholds()[2], 1.5);
-}
-
-TEST(Detection, InertialMarginOptionsAreValidated) {
-  DetectionOptions options;
-  options.inertial_margin = VectorX::Constant(2, 0.01);
-  EXPECT_THROW(validate(options, kJoints), Error);
-  options.inertial_margin = VectorX::Constant(1, -0.01);
-  EXPECT_THROW(validate(options, kJoints), Error);
-  options.inertial_margin = VectorX::Constant(1, NAN);
-  EXPECT_THROW(validate(options, kJoints), Error);
-  options.inertial_margin = VectorX::Constant(kJoints, 0.01);
-  EXPECT_NO_THROW(validate(options, kJoints));
 }
 
 // In the estimator τ_dyn is τ − τ_f − g(q) + τ̂_ext = B q̈ + C q̇ (the torque that accelerates
