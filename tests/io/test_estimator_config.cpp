@@ -192,6 +192,10 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         BadConfig{"sensor: {type: ft}\nsenser: 1\n", ":3:", "senser", "unknown key"},
         BadConfig{"sensor:\n  type: ft\n  tipe: 2\n", ":4:", "sensor.tipe", "unknown key"},
+        // A key twice: YAML forbids it, yaml-cpp would read the first and drop the second.
+        BadConfig{"sensor: {type: ft}\ndetection: {tau_min: 1}\ndetection: {tau_min: 2}\n",
+                  ":4:", "detection", "given twice in one mapping (first at"},
+        BadConfig{"sensor: {type: none, type: ft}\n", ":2:", "sensor.type", "given twice"},
         BadConfig{"sensor: {type: laser}\n", ":2:", "sensor.type",
                   "expected one of ft, force, none"},
         BadConfig{"sensor: {pose: {xyz: [0, 0, 0]}}\n", ":2:", "sensor.type", "missing"},

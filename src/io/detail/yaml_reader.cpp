@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -68,6 +69,9 @@ void YamlReader::only_keys(const YAML::Node& map, const std::string& context,
                            std::initializer_list<const char*> allowed) const {
   if (!map.IsMap()) fail(map, context.empty() ? "(top level)" : context, "expected a mapping");
   const std::set<std::string> ok(allowed.begin(), allowed.end());
+  // YAML forbids a key twice in one mapping; yaml-cpp keeps both and map[k] reads the first, so
+  // a second `detection:` appended to a file would be ignored without a word.
+  std::map<std::string, YAML::Node> seen;
   for (const auto& kv : map) {
     if (!kv.first.IsScalar()) {
       fail(kv.first, context.empty() ? "(top level)" : context,
@@ -78,6 +82,12 @@ void YamlReader::only_keys(const YAML::Node& map, const std::string& context,
     const std::string k = kv.first.Scalar();
     if (ok.count(k) == 0)
       fail(kv.first, key(context, k), "unknown key (expected one of: " + listed(allowed) + ")");
+    const auto [first, inserted] = seen.emplace(k, kv.first);
+    if (!inserted) {
+      fail(kv.first, key(context, k),
+           "given twice in one mapping (first at " + where(first->second) +
+               "): merge the two or delete one");
+    }
   }
 }
 
