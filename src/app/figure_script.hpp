@@ -12,7 +12,7 @@
 
 namespace extwrench::detail {
 
-// Columns of a recorded row (plot_data.txt); q1..qn then q_d,1..q_d,n follow kQ.
+// Columns of a recorded row (plot_data.txt); the per-joint blocks (JointBlock) follow kQ.
 enum Col : int {
   kT = 0,
   kContact,
@@ -28,9 +28,23 @@ enum Col : int {
   kIll,            // 1 when the estimate is flagged ill_conditioned (damped)
   kTrueContact,
   kErrF,
-  kFPartial,  // the force of estimates flagged partial (observable part only), W
-  kQ = kFPartial + 3
+  kFPartial,                   // the force of estimates flagged partial (observable part only), W
+  kBaseForce = kFPartial + 3,  // ‖F̂_ext‖ of the base sensor (detection's force signal)
+  kForceThreshold,             // F_min
+  kQ
 };
+
+// The per-joint blocks after kQ, n columns each: joint_col(kResidual, n, i) is r_i's column.
+enum JointBlock : int {
+  kPosition = 0,  // q_i
+  kDesired,       // q_d,i of the controller, when known
+  kResidual,      // r_i = τ̂_ext,i, the signal the detector compares
+  kThreshold,     // τ_thr,i in force at that sample (it may follow |q̇_i| and |τ_dyn,i|)
+  kTrueTorque,    // true τ_ext,i (logs with true_tau_ext columns)
+  kJointBlocks
+};
+inline constexpr int joint_col(JointBlock block, int n, int i) { return kQ + block * n + i; }
+inline constexpr int row_width(int n) { return kQ + kJointBlocks * n; }
 
 inline constexpr const char* kAxis[] = {"x", "y", "z"};
 
@@ -48,8 +62,9 @@ struct PlotContext {
   int n = 0;          // joints
   bool truth = false;
   FigureFormat format = FigureFormat::kPng;
-  std::vector<char> present;   // per column: some value is finite
-  std::vector<char> positive;  // per column: some value is > 0 (log scales)
+  std::vector<char> present;             // per column: some value is finite
+  std::vector<char> positive;            // per column: some value is > 0 (log scales)
+  std::vector<std::string> joint_units;  // per joint: "N m" (revolute) or "N" (prismatic)
   double t_begin = 0.0, t_end = 1.0;
 };
 

@@ -68,9 +68,10 @@ std::string joints_script(const PlotContext& c, const Figure& f) {
   std::vector<Series> series;
   for (int i = 0; i < c.n; ++i) {
     const std::string lt = " lt " + std::to_string(i + 1);
-    series.push_back({kQ + i, "with lines lw 2" + lt, "q_" + std::to_string(i + 1)});
     series.push_back(
-        {kQ + c.n + i, "with lines lw 1 dt 2" + lt, "q_{d," + std::to_string(i + 1) + "}"});
+        {joint_col(kPosition, c.n, i), "with lines lw 2" + lt, "q_" + std::to_string(i + 1)});
+    series.push_back({joint_col(kDesired, c.n, i), "with lines lw 1 dt 2" + lt,
+                      "q_{d," + std::to_string(i + 1) + "}"});
   }
   plot_series(s, c, series, "no joint positions in the log");
   return s.str();
@@ -121,16 +122,17 @@ std::string line_point_script(const PlotContext& c, const Figure& f) {
   return s.str();
 }
 
-// The time spans where the estimate was flagged ill_conditioned (the solver damped), as shaded
-// rectangles behind the curves; spans closer than 1/kMaxSpans of the log are merged, so that a
-// flag that flickers draws a few rectangles, not thousands.
-std::string flagged_spans(const EnvelopeDecimator& rows, double t_begin, double t_end) {
+// The time spans where a 0/1 column (ill_conditioned, contact) is set, as shaded rectangles
+// behind the curves; spans closer than 1/kMaxSpans of the log are merged, so that a flag that
+// flickers draws a few rectangles, not thousands.
+std::string flagged_spans(const EnvelopeDecimator& rows, int column, const char* colour,
+                          double t_begin, double t_end) {
   constexpr int kMaxSpans = 200;
   const double gap = (t_end - t_begin) / kMaxSpans;
   std::vector<std::pair<double, double>> spans;
   for (int i = 0; i < rows.rows(); ++i) {
     const double* r = rows.row(i);
-    if (!(r[kIll] > 0.5)) continue;
+    if (!(r[column] > 0.5)) continue;
     if (!spans.empty() && r[kT] - spans.back().second <= gap) {
       spans.back().second = r[kT];
     } else {
@@ -141,10 +143,14 @@ std::string flagged_spans(const EnvelopeDecimator& rows, double t_begin, double 
   int id = 10;
   for (const auto& [a, b] : spans) {
     s << "set object " << id++ << " rect from " << a << ", graph 0 to "
-      << std::max(b, a + gap * 0.2) << ", graph 1 behind fc rgb '#fdd0c8' fs solid 1.0 noborder\n";
+      << std::max(b, a + gap * 0.2) << ", graph 1 behind fc rgb '" << colour
+      << "' fs solid 1.0 noborder\n";
   }
   return s.str();
 }
+
+constexpr const char* kDampedColour = "#fdd0c8";
+constexpr const char* kContactColour = "#dbe7f4";
 
 // Fig. 10: condition numbers, the solver's damping threshold and the damped spans.
 std::string condition_script(const PlotContext& c, const Figure& f, const EnvelopeDecimator& rows,
@@ -153,7 +159,7 @@ std::string condition_script(const PlotContext& c, const Figure& f, const Envelo
   s << gnuplot_preamble(f.output, c.format, 1100, 600) << kKey << "set title "
     << gnuplot_quote("Condition number — " + enhanced(c.title))
     << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\n";
-  const std::string spans = flagged_spans(rows, c.t_begin, c.t_end);
+  const std::string spans = flagged_spans(rows, kIll, kDampedColour, c.t_begin, c.t_end);
   s << spans;
   std::string extra;
   if (max_condition > 0.0) {
@@ -164,8 +170,8 @@ std::string condition_script(const PlotContext& c, const Figure& f, const Envelo
     extra += ", " + std::to_string(3.0 * max_condition) + " with lines lt nodraw notitle";
   }
   if (!spans.empty())
-    extra +=
-        ", keyentry with boxes fc rgb '#fdd0c8' fs solid 1.0 noborder title 'damped (flagged)'";
+    extra += std::string(", keyentry with boxes fc rgb '") + kDampedColour +
+             "' fs solid 1.0 noborder title 'damped (flagged)'";
   plot_series(
       s, c,
       {{kCond, "with lines lw 2 lc rgb '#1f77b4'", "J inverted by the estimator"},
@@ -175,9 +181,67 @@ std::string condition_script(const PlotContext& c, const Figure& f, const Envelo
   return s.str();
 }
 
+// What the detector compared, one panel per joint: r_i = τ̂_ext,i between ±τ_thr,i (thresholds
+// that follow the motion drawn as they were at each sample) and the true τ_ext,i when logged;
+// with a base sensor a last panel of ‖F̂_ext‖ against F_min; declared contact shaded. It shows
+// which joint raised an alarm and by how much, the margin a threshold keeps in free motion.
+std::string residual_script(const PlotContext& c, const Figure& f, const EnvelopeDecimator& rows) {
+  const bool force_panel = c.present[kForceThreshold] != 0;
+  const int panels = c.n + (force_panel ? 1 : 0);
+  std::ostringstream s;
+  s << gnuplot_preamble(f.output, c.format, 1100, 120 + 150 * panels) << kKey
+    << "set multiplot layout " << panels << ",1 title "
+    << gnuplot_quote("Detection: residuals r_i and thresholds ±τ_{thr,i} — " + enhanced(c.title))
+    << "\nset lmargin 10\nset rmargin 22\n";
+  const std::string spans = flagged_spans(rows, kContact, kContactColour, c.t_begin, c.t_end);
+  s << spans;
+  const std::string contact_key =
+      spans.empty() ? std::string()
+                    : std::string(", keyentry with boxes fc rgb '") + kContactColour +
+                          "' fs solid 1.0 noborder title 'contact declared'";
+  for (int i = 0; i < c.n; ++i) {
+    const std::string j = std::to_string(i + 1);
+    const int threshold = joint_col(kThreshold, c.n, i);
+    s << "set ylabel 'r_{" << j << "} [" << c.joint_units[static_cast<std::size_t>(i)] << "]'\n"
+      << (i + 1 == panels ? "set xlabel 't [s]'\n" : "unset xlabel\n");
+    std::string extra;
+    // −τ_thr, and undrawn curves at ±1.15 τ_thr so that autoscale keeps both lines inside the
+    // frame (on a quiet joint they would lie on its edges).
+    if (c.present[static_cast<std::size_t>(threshold)]) {
+      const std::string t = "$" + col(threshold);
+      extra = ", " + c.data + " using 1:(-" + t + ") with lines lw 1 lc rgb 'black' notitle, " +
+              c.data + " using 1:(1.15*" + t + ") with lines lt nodraw notitle, " + c.data +
+              " using 1:(-1.15*" + t + ") with lines lt nodraw notitle";
+    }
+    if (i == 0) extra += contact_key;
+    plot_series(
+        s, c,
+        {{joint_col(kResidual, c.n, i), "with lines lw 1.5 lc rgb '#1f77b4'", "r_{" + j + "}"},
+         {joint_col(kTrueTorque, c.n, i), "with lines lw 1.5 dt 2 lc rgb '#d62728'",
+          "true τ_{ext," + j + "}"},
+         {threshold, "with lines lw 1 lc rgb 'black'", "±τ_{thr," + j + "}"}},
+        "no residual (the estimator never started)", false, extra);
+  }
+  if (force_panel) {
+    s << "set ylabel '‖F_{ext}‖ [N]'\nset xlabel 't [s]'\n";
+    plot_series(s, c,
+                {{kBaseForce, "with lines lw 1.5 lc rgb '#1f77b4'", "‖F_{ext}‖, base sensor"},
+                 {kForceThreshold, "with lines lw 1 lc rgb 'black'", "F_{min}"}},
+                "no base force (the sensor was taring)");
+  }
+  s << "unset multiplot\n";
+  return s.str();
+}
+
 // The per-column facts the scripts need: which columns have data, and the time span.
-PlotContext context_of(const FigureOptions& o, const EnvelopeDecimator& rows, int n, bool truth) {
+PlotContext context_of(const FigureOptions& o, const EnvelopeDecimator& rows, const Model& model,
+                       bool truth) {
+  const int n = model.nq();
   PlotContext c;
+  for (int i = 1; i <= n; ++i) {
+    const bool prismatic = model.joints[static_cast<std::size_t>(i)].type == JointType::kPrismatic;
+    c.joint_units.emplace_back(prismatic ? "N" : "N m");
+  }
   c.dir = o.dir;
   c.data = gnuplot_quote("plot_data.txt");
   c.title = o.title;
@@ -223,29 +287,32 @@ std::vector<std::string> run_scripts(const std::vector<Figure>& figures) {
 
 }  // namespace
 
-FigureRecorder::FigureRecorder(const Model& model, bool truth, int max_points,
+FigureRecorder::FigureRecorder(const Model& model, bool truth, bool base_sensor, int max_points,
                                const sim::SinusoidalTrajectory* desired)
     : model_(model),
       truth_(truth),
+      base_sensor_(base_sensor),
       desired_(desired != nullptr && desired->size() == model.nq() ? desired : nullptr),
-      rows_(kQ + 2 * model.nq(), max_points),
-      snapshot_rows_(kQ + 2 * model.nq(), 64),
-      row_(static_cast<std::size_t>(kQ + 2 * model.nq())),
+      rows_(row_width(model.nq()), max_points),
+      snapshot_rows_(row_width(model.nq()), 64),
+      row_(static_cast<std::size_t>(row_width(model.nq()))),
       data_(model),
       q_d_(model.nq()),
       dq_d_(model.nq()),
       ddq_d_(model.nq()) {}
 
-void FigureRecorder::add(const Sample& sample, const ContactEstimate& estimate) {
+void FigureRecorder::add(const Sample& sample, const ContactEstimate& estimate,
+                         const ContactDetector& detector) {
   double* r = row_.data();
   const int n = model_.nq();
   r[kT] = sample.t;
   estimate_columns(sample, estimate, r);
   truth_columns(sample, estimate, r);
+  detection_columns(sample, estimate, detector, r);
   if (desired_ != nullptr) desired_->evaluate(sample.t, q_d_, dq_d_, ddq_d_);
   for (int i = 0; i < n; ++i) {
-    r[kQ + i] = sample.q[i];
-    r[kQ + n + i] = desired_ != nullptr ? q_d_[i] : kNaN;
+    r[joint_col(kPosition, n, i)] = sample.q[i];
+    r[joint_col(kDesired, n, i)] = desired_ != nullptr ? q_d_[i] : kNaN;
   }
   rows_.push(r);
   snapshot_rows_.push(r);
@@ -271,6 +338,26 @@ void FigureRecorder::estimate_columns(const Sample& s, const ContactEstimate& e,
     forward_poses(model_, data_, s.q);  // all jacobian_condition needs
     r[kCondEstimated] = jacobian_condition(model_, data_, e.link);
   }
+}
+
+// What the detector compared at this sample: r_i against τ_thr,i (which may follow the motion)
+// and, with a base sensor, ‖F̂_ext‖ against F_min; the true τ_ext,i beside them when logged.
+void FigureRecorder::detection_columns(const Sample& s, const ContactEstimate& e,
+                                       const ContactDetector& d, double* r) const {
+  const int n = model_.nq();
+  const VectorX& threshold = d.thresholds();
+  for (int i = 0; i < n; ++i) {
+    r[joint_col(kResidual, n, i)] = e.residual.size() == n ? e.residual[i] : kNaN;
+    r[joint_col(kThreshold, n, i)] = threshold.size() == n ? threshold[i] : kNaN;
+    r[joint_col(kTrueTorque, n, i)] =
+        s.has_true_tau_ext && s.truth.tau_ext.size() == n ? s.truth.tau_ext[i] : kNaN;
+  }
+  // With a sensor the estimate's force is F̂_ext of eq. (11) (Table I, cases A-D), what the
+  // detector compares with F_min; none while the sensor is taring.
+  const bool base_force = base_sensor_ && e.has(EstimateFlag::kForce) &&
+                          !e.has(EstimateFlag::kTaring) && e.force_W.allFinite();
+  r[kBaseForce] = base_force ? e.force_W.norm() : kNaN;
+  r[kForceThreshold] = base_sensor_ ? d.options().f_min : kNaN;
 }
 
 void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, double* r) {
@@ -301,13 +388,14 @@ DrawnFigures FigureRecorder::draw(const FigureOptions& o, OutputFiles& parent) c
   const std::filesystem::path data = o.dir / "plot_data.txt";
   rows_.write(outputs.stage(data));
   outputs.commit(data);
-  const PlotContext c = context_of(o, rows_, model_.nq(), truth_);
+  const PlotContext c = context_of(o, rows_, model_, truth_);
   std::vector<Figure> figures{figure(c, "joints"), figure(c, "force"), figure(c, "line_point"),
-                              figure(c, "condition")};
+                              figure(c, "condition"), figure(c, "residual")};
   outputs.write_text(figures[0].script, joints_script(c, figures[0]));
   outputs.write_text(figures[1].script, force_script(c, figures[1]));
   outputs.write_text(figures[2].script, line_point_script(c, figures[2]));
   outputs.write_text(figures[3].script, condition_script(c, figures[3], rows_, o.max_condition));
+  outputs.write_text(figures[4].script, residual_script(c, figures[4], rows_));
   const Robot3dInput in{model_, o.geometry, snapshot_rows_, o.snapshots, o.p_WS, truth_};
   figures.push_back(plot_robot3d(c, in, outputs));
   for (const Figure& f : figures) (void)outputs.stage(f.output);  // gnuplot draws to .partial

@@ -13,6 +13,7 @@
 #include "extwrench/core/sample.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/estimation/contact_estimate.hpp"
+#include "extwrench/estimation/detection.hpp"
 #include "extwrench/geometry/shapes.hpp"
 #include "extwrench/io/output_files.hpp"
 #include "extwrench/sim/trajectory.hpp"
@@ -39,24 +40,28 @@ struct DrawnFigures {
 class FigureRecorder {
  public:
   /// truth: the log has truth columns (true force and point, the force error, cond(J) of the
-  /// true contact link). desired: the trajectory the controller tracked (q_d in the joint
+  /// true contact link). base_sensor: the estimator reads a base sensor (its ‖F̂_ext‖ is a
+  /// detection signal). desired: the trajectory the controller tracked (q_d in the joint
   /// plot), or null. About 2·max_points rows are kept.
-  FigureRecorder(const Model& model, bool truth, int max_points,
+  FigureRecorder(const Model& model, bool truth, bool base_sensor, int max_points,
                  const sim::SinusoidalTrajectory* desired = nullptr);
 
-  /// One replayed sample and the estimate at it.
-  void add(const Sample& sample, const ContactEstimate& estimate);
+  /// One replayed sample, the estimate at it and the detector that made it (its thresholds).
+  void add(const Sample& sample, const ContactEstimate& estimate, const ContactDetector& detector);
 
   /// Writes the data and the scripts and runs gnuplot on them, every file through `outputs`;
-  /// the figures in the order joints, force, line_point, condition, robot3d.
+  /// the figures in the order joints, force, line_point, condition, residual, robot3d.
   [[nodiscard]] DrawnFigures draw(const FigureOptions& options, OutputFiles& outputs) const;
 
  private:
   void estimate_columns(const Sample& s, const ContactEstimate& e, double* row);
+  void detection_columns(const Sample& s, const ContactEstimate& e, const ContactDetector& d,
+                         double* row) const;
   void truth_columns(const Sample& s, const ContactEstimate& e, double* row);
 
   const Model& model_;
   bool truth_;
+  bool base_sensor_;
   const sim::SinusoidalTrajectory* desired_;
   EnvelopeDecimator rows_;   // the time plots
   Decimator snapshot_rows_;  // whole rows (real configurations) for the 3-D view

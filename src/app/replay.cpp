@@ -91,6 +91,8 @@ class RowEstimator {
   }
   /// What every estimate looks like (sizes), for the pipeline's buffers.
   [[nodiscard]] const ContactEstimate& prototype() const { return first_; }
+  /// The detector of the last update (its thresholds in force).
+  [[nodiscard]] const ContactDetector& detector() const { return estimator_.detector(); }
 
   const ContactEstimate& update(const Sample& s) {
     if (started_) {
@@ -218,7 +220,10 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   EstimatesWriter writer(outputs.stage(estimates), model, estimator_options.drift.has_value());
   WindowMetrics metrics(o.windows);
   std::optional<detail::FigureRecorder> figures;
-  if (o.figures) figures.emplace(model, layout.truth, o.plot_points, o.desired_trajectory);
+  if (o.figures) {
+    figures.emplace(model, layout.truth, estimator_options.sensor.type != SensorType::kNone,
+                    o.plot_points, o.desired_trajectory);
+  }
   const std::string title = title_of(o);
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
   LogSpan span;
@@ -233,7 +238,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     contact_samples += e.contact ? 1 : 0;
     disagreement_samples += e.contact && e.has(EstimateFlag::kDisagreement) ? 1 : 0;
     if (layout.truth) metrics.add(s, e);
-    if (figures) figures->add(s, e);
+    if (figures) figures->add(s, e, estimator.detector());
     progress.update(span.rows, "%s: replayed %ld rows (t = %.1f s)", title.c_str(), span.rows, s.t);
   }
   progress.done();

@@ -167,7 +167,7 @@ void write_snapshot(Writer& w, const Robot3dInput& in, Data& data, const double*
                     double scale) {
   const int n = in.model.nq();
   VectorX q(n);
-  for (int i = 0; i < n; ++i) q[i] = row[kQ + i];
+  for (int i = 0; i < n; ++i) q[i] = row[joint_col(kPosition, n, i)];
   forward_kinematics(in.model, data, q);
   w.point(in.p_WS);
   for (int b = 0; b < in.model.num_bodies(); ++b)

@@ -6,9 +6,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -126,7 +128,7 @@ TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
     const CliRun r = estimate(config("cfg_" + type, sensor), "out_" + type);
     ASSERT_EQ(r.code, 0) << type << ": " << r.err;
     EXPECT_FALSE(contains(r.err, "warning")) << type << ": " << r.err;
-    for (const char* name : {"joints", "force", "line_point", "condition", "robot3d"}) {
+    for (const char* name : {"joints", "force", "line_point", "condition", "residual", "robot3d"}) {
       const fs::path png = dir_ / ("out_" + type) / (std::string(name) + ".png");
       ASSERT_TRUE(fs::exists(png)) << png;
       // A PNG file, not an empty or half-written one: its signature and a plausible size.
@@ -135,7 +137,7 @@ TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
     }
     // Every panel of the time plots spans the same interval (the log's), so that they line up:
     // one `set xrange` before each plot, all equal, and never gnuplot's rounded autoscale.
-    for (const char* name : {"joints", "force", "line_point", "condition"}) {
+    for (const char* name : {"joints", "force", "line_point", "condition", "residual"}) {
       const std::string script = read_text(dir_ / ("out_" + type) / (std::string(name) + ".gp"));
       EXPECT_FALSE(contains(script, "set autoscale x")) << name;
       std::size_t at = 0, ranges = 0;
@@ -159,6 +161,103 @@ TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
   ASSERT_EQ(with_truth.code, 0) << with_truth.err;
   EXPECT_EQ(read_text(dir_ / "out_ft/estimates.csv"),
             read_text(dir_ / "out_ft_truth/estimates.csv"));
+}
+
+// A cell's number; NaN for empty or text cells ("ok", "link6").
+double number_of(const std::string& cell) {
+  char* end = nullptr;
+  const double x = std::strtod(cell.c_str(), &end);
+  return !cell.empty() && end == cell.c_str() + cell.size() ? x : std::nan("");
+}
+
+// The CSV file as columns by header name (numbers; NaN for text).
+std::map<std::string, std::vector<double>> csv_columns(const fs::path& path) {
+  std::istringstream in(read_text(path));
+  std::string line;
+  std::getline(in, line);
+  const std::vector<std::string> names = test::split_cells(line);
+  std::map<std::string, std::vector<double>> columns;
+  while (std::getline(in, line)) {
+    const std::vector<std::string> cells = test::split_cells(line);
+    for (std::size_t k = 0; k < names.size() && k < cells.size(); ++k)
+      columns[names[k]].push_back(number_of(cells[k]));
+  }
+  return columns;
+}
+
+// The 1-based data column that the script plots with this title ("using 1:N ... title 'T'").
+int plotted_column(const std::string& script, const std::string& title) {
+  const auto at = script.find("title '" + title + "'");
+  if (at == std::string::npos) return -1;
+  const auto using_at = script.rfind("using 1:", at);
+  return using_at == std::string::npos ? -1 : std::stoi(script.substr(using_at + 8));
+}
+
+TEST_F(RealLog, TheResidualFigureDrawsWhatTheDetectorCompared) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot not installed";
+  // Thresholds that follow |q̇| (a calibration's form): τ_thr,i = 2 + 0.5 |q̇_i| N m.
+  const fs::path cfg =
+      config("cfg_speed", "{type: ft, pose: {xyz: [0, 0, -0.31], rpy: [0, 0, 0]}}");
+  std::string text = read_text(cfg);
+  const auto at = text.find("detection: {tau_min: 1.0, f_min: 5.0}");
+  ASSERT_NE(at, std::string::npos) << text;
+  text.replace(at, 37, "detection: {tau_min: 2.0, tau_per_speed: 0.5, f_min: 5.0}");
+  write_text(cfg, text);
+  // Every row kept (no decimation: 2.5 s at 1 kHz), so plotted rows are the replayed samples.
+  const CliRun r = estimate(cfg, "out_speed", "--plot-points 10000");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string script = read_text(dir_ / "out_speed/residual.gp");
+  const std::map<std::string, std::vector<double>> log = csv_columns(dir_ / "robot_log.csv");
+  const std::map<std::string, std::vector<double>> est =
+      csv_columns(dir_ / "out_speed/estimates.csv");
+  std::vector<std::vector<double>> rows;
+  {
+    std::istringstream in(read_text(dir_ / "out_speed/plot_data.txt"));
+    std::string line;
+    while (std::getline(in, line)) {
+      std::istringstream cells(line);
+      std::vector<double> row;
+      std::string cell;
+      while (cells >> cell) row.push_back(number_of(cell));
+      rows.push_back(row);
+    }
+  }
+  ASSERT_GE(rows.size(), log.at("t").size());
+  const std::vector<double>& t = log.at("t");
+  for (int i = 1; i <= 7; ++i) {
+    const std::string j = std::to_string(i);
+    const int r_col = plotted_column(script, "r_{" + j + "}");
+    const int thr_col = plotted_column(script, "±τ_{thr," + j + "}");
+    ASSERT_GT(r_col, 1) << "joint " << j << "\n" << script;
+    ASSERT_GT(thr_col, 1) << "joint " << j;
+    // −τ_thr is drawn from the same column.
+    EXPECT_TRUE(contains(script, "using 1:(-$" + std::to_string(thr_col) + ")")) << j;
+    const std::vector<double>& dq = log.at("dq" + j);
+    const std::vector<double>& residual = est.at("r" + j);
+    std::size_t k = 0, checked = 0;
+    for (const std::vector<double>& row : rows) {
+      while (k < t.size() && t[k] < row[0] - 1e-9) ++k;
+      ASSERT_LT(k, t.size());
+      ASSERT_NEAR(t[k], row[0], 1e-9);
+      if (k == 0) continue;  // the first sample only starts the estimator
+      EXPECT_NEAR(row[static_cast<std::size_t>(thr_col - 1)], 2.0 + 0.5 * std::abs(dq[k]), 1e-6)
+          << "joint " << j << ", t = " << t[k];
+      EXPECT_NEAR(row[static_cast<std::size_t>(r_col - 1)], residual[k],
+                  1e-6 * (1.0 + std::abs(residual[k])))
+          << "joint " << j << ", t = " << t[k];
+      ++checked;
+    }
+    EXPECT_GT(checked, 2000u);
+  }
+  // The base sensor's force against F_min in a last panel, the declared contact shaded.
+  EXPECT_GT(plotted_column(script, "F_{min}"), 1) << script;
+  EXPECT_TRUE(contains(script, "contact declared")) << script;
+  // Without a sensor: no force panel.
+  const CliRun none = estimate(config("cfg_none_res", "{type: none}", "no_sensor"), "out_none_res");
+  ASSERT_EQ(none.code, 0) << none.err;
+  const std::string none_script = read_text(dir_ / "out_none_res/residual.gp");
+  EXPECT_EQ(plotted_column(none_script, "F_{min}"), -1);
+  EXPECT_GT(plotted_column(none_script, "r_{7}"), 1);
 }
 
 TEST_F(RealLog, WithoutSensorPoseTheModelsSensorFrameIsUsedAndSaid) {

@@ -184,7 +184,8 @@ Verdict judge(const Table& log, const Table& estimates) {
 }
 
 const std::vector<std::string> kSensorTypes{"ft", "force", "none"};
-const std::vector<std::string> kFigures{"joints", "force", "line_point", "condition", "robot3d"};
+const std::vector<std::string> kFigures{"joints",    "force",    "line_point",
+                                        "condition", "residual", "robot3d"};
 
 class NewUser : public test::ScratchDirTest, public ::testing::WithParamInterface<Robot> {
  protected:
