@@ -106,9 +106,13 @@ const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const Vecto
   // so S q_dot, S q_ddot, v x S q_dot and S^T f are a few scalars; no world pose is formed
   // (docs/algorithms.md, "Inverse dynamics").
   const int nb = model.num_bodies();
-  // Before the angles below: it writes data.sin_q, data.cos_q of its own.
-  if (!external.empty()) forward_poses(model, data, q);
-  detail::sin_cos_poly_n(q.data(), data.sin_q.data(), data.cos_q.data(), nb - 1);
+  // The external wrenches need world poses; forward_poses leaves in data.sin_q, data.cos_q the
+  // very sines and cosines this pass needs (detail::joint_sin_cos, the same polynomial).
+  if (!external.empty()) {
+    forward_poses(model, data, q);
+  } else {
+    detail::sin_cos_poly_n(q.data(), data.sin_q.data(), data.cos_q.data(), nb - 1);
+  }
   // Prismatic joints turn by 0: (c, s) = (1, 0) keeps one path for both types.
   for (int j = 0; j < nb - 1; ++j) {
     const double r = data.aligned[static_cast<std::size_t>(j + 1)].revolute;

@@ -139,6 +139,22 @@ inline void extreme_eigenvalues(const Eigen::Matrix<double, R, R>& A,
     guess.size = R;
   }
 }
+
+/// A = J Jᵀ and y = J b over the first `cols` columns of J (R×n), as sums over the columns:
+/// fixed-size R×R updates (the dynamic inner length of a product takes Eigen's generic path,
+/// ~3× the instructions at these sizes).
+template <int R, typename Derived, typename VectorB>
+inline void normal_equations(const Eigen::MatrixBase<Derived>& J, int cols, const VectorB& b,
+                             Eigen::Matrix<double, R, R>& A,
+                             Eigen::Matrix<double, R, 1>& y) noexcept {
+  A.setZero();
+  y.setZero();
+  for (int k = 0; k < cols; ++k) {
+    const Eigen::Matrix<double, R, 1> j_k = J.col(k);
+    A.noalias() += j_k * j_k.transpose();
+    y += b[k] * j_k;
+  }
+}
 }  // namespace detail
 
 /// Solves Jᵀ x = b in the damped least-squares sense, J: R×n of which only the first `cols`
@@ -154,15 +170,8 @@ inline DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, int cols, const
                             const SolverOptions& opt, Eigen::Matrix<double, R, 1>& x,
                             SpectrumGuess& guess) noexcept {
   using MatR = Eigen::Matrix<double, R, R>;
-  // J Jᵀ and J b as sums over the columns: fixed-size R×R updates (the dynamic inner length
-  // of a product takes Eigen's generic path, ~3× the instructions at these sizes).
-  MatR A = MatR::Zero();
-  x.setZero();
-  for (int k = 0; k < cols; ++k) {
-    const Eigen::Matrix<double, R, 1> j_k = J.col(k);
-    A.noalias() += j_k * j_k.transpose();
-    x += b[k] * j_k;
-  }
+  MatR A;
+  detail::normal_equations<R>(J, cols, b, A, x);
   MatR L = A;
   const bool factored = ldlt_in_place(L);
   double l_min = 0.0;
@@ -209,9 +218,8 @@ inline int min_norm_solve(const Eigen::MatrixBase<Derived>& J, int cols, const V
   using MatR = Eigen::Matrix<double, R, R>;
   using VecR = Eigen::Matrix<double, R, 1>;
   MatR A;
-  A.noalias() = J.leftCols(cols) * J.leftCols(cols).transpose();
   VecR y;
-  y.noalias() = J.leftCols(cols) * b.head(cols);
+  detail::normal_equations<R>(J, cols, b, A, y);
   const Eigen::SelfAdjointEigenSolver<MatR> eig(A);
   const VecR& lambda = eig.eigenvalues();  // increasing
   const double floor = rank_tolerance * rank_tolerance * std::max(lambda[R - 1], 0.0);
