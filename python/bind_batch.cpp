@@ -63,7 +63,7 @@ BatchInput read_batch(const Estimator& e, const py::handle& t, const py::handle&
 /// The output columns, allocated with the GIL held and written without it.
 struct BatchOutput {
   py::array_t<double> t, force, moment, point, point_L, line_point, line_direction, surface, cond,
-      residual, sigma_f, sigma_m, sigma_line, sigma_point;
+      residual, threshold, sigma_f, sigma_m, sigma_line, sigma_point;
   py::array_t<bool> contact;
   py::array_t<std::int32_t> link, status;
   py::array_t<std::uint32_t> flags;
@@ -81,6 +81,7 @@ struct BatchOutput {
         surface(rows),
         cond(rows),
         residual({rows, static_cast<py::ssize_t>(n)}),
+        threshold({rows, static_cast<py::ssize_t>(n)}),
         sigma_f(rows),
         sigma_m(rows),
         sigma_line(rows),
@@ -94,7 +95,7 @@ struct BatchOutput {
 
 struct RowWriter {
   double *t, *force, *moment, *point, *point_L, *line_point, *line_direction, *surface, *cond,
-      *residual, *sigma_f, *sigma_m, *sigma_line, *sigma_point;
+      *residual, *threshold, *sigma_f, *sigma_m, *sigma_line, *sigma_point;
   bool* contact;
   std::int32_t *link, *status;
   std::uint32_t* flags;
@@ -117,6 +118,7 @@ struct RowWriter {
         surface(o.surface.mutable_data()),
         cond(o.cond.mutable_data()),
         residual(o.residual.mutable_data()),
+        threshold(o.threshold.mutable_data()),
         sigma_f(o.sigma_f.mutable_data()),
         sigma_m(o.sigma_m.mutable_data()),
         sigma_line(o.sigma_line.mutable_data()),
@@ -150,7 +152,8 @@ struct RowWriter {
     for (int i = 0; i < 3; ++i) dst[3 * k + static_cast<std::size_t>(i)] = v[i];
   }
 
-  void write(std::size_t k, const ContactEstimate& e) {
+  /// Row k: the estimate and the detector's thresholds τ_thr it was compared with.
+  void write(std::size_t k, const ContactEstimate& e, const VectorX& thresholds) {
     t[k] = e.t;
     contact[k] = e.contact;
     // As estimates.csv: the link column is empty unless a contact is declared.
@@ -172,6 +175,8 @@ struct RowWriter {
     status[k] = status_of(e);
     double* r = residual + k * static_cast<std::size_t>(n);
     for (int i = 0; i < n; ++i) r[i] = e.residual.size() == n ? e.residual[i] : std::nan("");
+    double* thr = threshold + k * static_cast<std::size_t>(n);
+    for (int i = 0; i < n; ++i) thr[i] = thresholds.size() == n ? thresholds[i] : std::nan("");
   }
 };
 
@@ -202,7 +207,7 @@ void run_rows(ContactEstimator& est, const BatchInput& in, int n, RowWriter& w) 
     }
     if (started) {
       (void)est.update(t, q, dq, tau, reading);  // the status is in the status column
-      w.write(static_cast<std::size_t>(k), est.result());
+      w.write(static_cast<std::size_t>(k), est.result(), est.detector().thresholds());
       continue;
     }
     const Status st = est.reset(t, q, dq, tau);
@@ -211,7 +216,7 @@ void run_rows(ContactEstimator& est, const BatchInput& in, int n, RowWriter& w) 
     first.residual = VectorX::Zero(n);
     first.status = st;
     started = st.ok();
-    w.write(static_cast<std::size_t>(k), first);
+    w.write(static_cast<std::size_t>(k), first, est.detector().thresholds());
   }
 }
 
@@ -241,6 +246,7 @@ py::dict estimate_batch(const Estimator& source, const py::handle& t, const py::
   d["status_names"] = out.status_names;
   d["cond"] = out.cond;
   d["residual"] = out.residual;
+  d["threshold"] = out.threshold;
   d["point_L"] = out.point_L;
   d["line_direction_W"] = out.line_direction;
   d["surface_distance"] = out.surface;

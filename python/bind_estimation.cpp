@@ -255,6 +255,11 @@ Returns an Estimate. Bad input raises ValueError naming it; the state is then un
             e.estimator.set_sensor_bias(b);
           },
           "(6,) sensor bias [f; n] in the sensor frame.")
+      .def_property_readonly(
+          "thresholds",
+          [](const Estimator& e) { return VectorX(e.estimator.detector().thresholds()); },
+          "(n,) the detector's joint thresholds τ_thr at the last update: τ_min, plus b|q̇| and "
+          "c|τ_dyn| when they follow the motion (docs/calibration.md).")
       .def_property_readonly("nq", &Estimator::nq)
       .def_property_readonly("bodies", [](const Estimator& e) { return *e.body_names; })
       .def_property_readonly(

@@ -96,6 +96,24 @@ def test_batch_columns_and_views(robot, log):
     assert out["status"][0] == "free" and not out["residual"][0].any()
 
 
+def test_thresholds_are_those_the_detector_compared(robot, log):
+    # Thresholds that follow the joint speed: tau_thr,i = 2 + 0.5 |dq_i| (docs/calibration.md),
+    # computed here from the log's dq, not read back from the library.
+    t, q, dq, tau, reading = log
+    config = dict(CONFIG, detection={"tau_min": 2.0, "tau_per_speed": 0.5, "f_min": 5.0})
+    est = extwrench.ContactEstimator(robot, config)
+    out = extwrench.estimate(est, *log)
+    assert out["threshold"].shape == (len(t), robot.nq)
+    np.testing.assert_allclose(out["threshold"][1:], 2.0 + 0.5 * np.abs(dq[1:]), rtol=0, atol=1e-12)
+    est.reset(t[0], q[0], dq[0], tau[0])
+    for k in (1, 250, len(t) - 1):  # the speed part depends on this sample's dq only
+        est.update(t[k], q[k], dq[k], tau[k], reading[k])
+        assert np.array_equal(bits(est.thresholds), bits(out["threshold"][k])), k
+    # Constant thresholds by default: tau_min on every row.
+    plain = extwrench.estimate(extwrench.ContactEstimator(robot, CONFIG), *log)
+    assert (plain["threshold"] == 1.0).all()
+
+
 def test_layouts_and_dtypes_give_the_same_estimates(robot, log):
     t, q, dq, tau, reading = log
     est = extwrench.ContactEstimator(robot, CONFIG)
