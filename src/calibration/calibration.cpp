@@ -6,6 +6,7 @@
 #include <string>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "friction_fit.hpp"
@@ -356,6 +357,8 @@ void gravity_series(const Model& model, const std::vector<Sample>& samples, bool
   }
   for (JointSeries& js : series) {
     js.gravity.assign(N, 0.0);
+    js.q.assign(N, 0.0);
+    js.axis_along_gravity = true;
     if (payload_columns)
       for (std::vector<double>& p : js.payload_gravity) p.assign(N, 0.0);
   }
@@ -363,12 +366,21 @@ void gravity_series(const Model& model, const std::vector<Sample>& samples, bool
   std::vector<Data> data;  // one per model: Data caches its model's mass properties
   data.reserve(count);
   for (std::size_t c = 0; c < count; ++c) data.emplace_back(models[c]);
+  Data poses(model);
+  const double g_norm = model.gravity.norm();
   for (std::size_t k = 0; k < N; ++k) {
     for (std::size_t c = 0; c < count; ++c)
       g[c] = gravity_torques(models[c], data[c], samples[k].q);
+    forward_poses(model, poses, samples[k].q);  // the axes in W: S_i's angular part
+    for (int i = 0; i < n; ++i) {
+      const Vector3 axis = poses.S[static_cast<std::size_t>(i) + 1].tail<3>();
+      if (g_norm > 0.0 && axis.cross(model.gravity).norm() > 1e-6 * g_norm * axis.norm())
+        series[static_cast<std::size_t>(i)].axis_along_gravity = false;
+    }
     for (int i = 0; i < n; ++i) {
       JointSeries& js = series[static_cast<std::size_t>(i)];
       js.gravity[k] = g[0][i];
+      js.q[k] = samples[k].q[i];
       if (!payload_columns) continue;
       js.payload_gravity[0][k] = g[1][i] - g[0][i];
       for (std::size_t a = 1; a < 4; ++a) js.payload_gravity[a][k] = g[a + 1][i] - g[1][i];

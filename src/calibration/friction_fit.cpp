@@ -1,6 +1,7 @@
 #include "friction_fit.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -114,6 +115,25 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
   f.intercept = f.mean_y - f.slope * f.mean_x;
   if (f.syy > 1e-300) f.r2 = f.sxy * f.sxy / (f.sxx * f.syy);
   return f;
+}
+
+bool inertia_aliases_gravity(const JointSeries& s, const std::vector<char>& use,
+                             double& correlation) {
+  constexpr double kAliasCorrelation = 0.95;
+  correlation = 0.0;
+  const std::size_t N = s.dq.size();
+  if (s.axis_along_gravity || N < 3 || s.q.size() != N || s.dt.size() != N || use.size() != N)
+    return false;
+  std::vector<double> acceleration(N, 0.0);
+  std::vector<char> inner(N, 0);  // the used samples with a central difference
+  for (std::size_t k = 1; k + 1 < N; ++k) {
+    acceleration[k] = (s.dq[k + 1] - s.dq[k - 1]) / (s.dt[k] + s.dt[k + 1]);
+    inner[k] = use[k];
+  }
+  const LineFit a = fit_line(s.q, acceleration, inner);
+  if (a.sxx <= 1e-300 || a.syy <= 1e-300) return false;
+  correlation = a.sxy / std::sqrt(a.sxx * a.syy);
+  return std::abs(correlation) >= kAliasCorrelation;
 }
 
 void filter_regressor(const std::vector<double>& phi, const std::vector<double>& alpha,
@@ -247,6 +267,18 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                            &z_gravity[2], &z_gravity[3], &z_gravity[4], &z_inertia},
                           s.r0, use, options.regularisation);
     keep_inertia = gi.rss <= (1.0 - kMinInertiaGain) * g.rss;
+  }
+  // One sine per joint: q̈ follows q, and an inertia cannot be told from a gravity error that
+  // changes with q_i. Not applied; said, with what motion would tell them apart.
+  double correlation = 0.0;
+  if (keep_inertia && inertia_aliases_gravity(s, use, correlation)) {
+    keep_inertia = false;
+    best.warnings.push_back(
+        j + ": an inertia correction (" + std::to_string(best_solve_with.theta[3]) +
+        " kg m^2 fitted) is not applied: in this motion its acceleration follows its position " +
+        "(correlation " + std::to_string(correlation) + ", as with one sine per joint), so it " +
+        "cannot be told from a gravity error that changes with the joint's angle (a centre of " +
+        "mass off); record a motion that moves " + j + " with several frequencies at once");
   }
   if (keep_inertia) {
     best_with.viscous = best_solve_with.theta[0];

@@ -16,10 +16,13 @@ namespace extwrench::calibration_detail {
 /// empty: none), and r⁰ is then the filtered residual: the fit minimises what the detector sees.
 /// dt_k = t_k − t_{k−1} (dt_0 unused; empty: no inertia correction fitted); gravity: g_i(q_k),
 /// and payload_gravity: the gravity torque of a unit mass at the last link's origin and of unit
-/// first moments along its x, y, z (empty: not known).
+/// first moments along its x, y, z (empty: not known); q: the joint's position (with gravity);
+/// axis_along_gravity: the joint's axis stayed parallel to gravity over the log (a vertical
+/// first axis), so no mass distribution gives it a gravity torque.
 struct JointSeries {
-  std::vector<double> dq, r0, alpha, dt, filter_weight, gravity;
+  std::vector<double> q, dq, r0, alpha, dt, filter_weight, gravity;
   std::array<std::vector<double>, 4> payload_gravity;
+  bool axis_along_gravity = false;
 };
 
 /// The fitted friction of one joint and its fit statistics.
@@ -62,6 +65,15 @@ void apply_residual_filter(const std::vector<double>& weight, std::vector<double
 /// weight of step k, from sample k − 1 to k, at k; 0 at k = 0).
 [[nodiscard]] std::vector<double> residual_filter_weights(const std::vector<Sample>& samples,
                                                           double cutoff);
+
+/// Whether an error of the joint's inertia and an error of its gravity torque give the same
+/// residual in this motion: gravity can load the joint (its axis is not along gravity) and its
+/// acceleration follows its position, |corr(q̈_i, q_i)| ≥ 0.95 over the used samples, as in a
+/// motion of one sine per joint (q̈ = −ω² (q − q0)). A gravity error that changes with q_i (a
+/// link's centre of mass off, not a multiple of the model's g_i) then looks like −δI q̈.
+/// `correlation` gets corr(q̈_i, q_i) (q̈ by central differences of q̇).
+[[nodiscard]] bool inertia_aliases_gravity(const JointSeries& s, const std::vector<char>& use,
+                                           double& correlation);
 
 /// Throws extwrench::Error when joint `joint` (1-based) does not move enough, in both
 /// directions, to identify its viscous and Coulomb friction over the samples in `use`.

@@ -146,7 +146,22 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
       // Beyond g(q): in a periodic motion the position, hence a gravity error, follows q̈ too.
       filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
       const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
-      if (inertia.extra_r2 >= kJointShare) {
+      double correlation = 0.0;
+      if (inertia.extra_r2 >= kJointShare && inertia_aliases_gravity(s, use, correlation)) {
+        // One sine per joint: q̈ follows q, and so does a gravity error that changes with q_i
+        // (not a multiple of g_i: a link's centre of mass off). Both named, and the remedy.
+        const double delta = -inertia.slope;
+        check.patterns.push_back(
+            {"inertia_or_gravity", joint, inertia.extra_r2,
+             "joint " + std::to_string(joint) +
+                 ": the calibrated residual follows the joint's acceleration (R^2 " +
+                 num(inertia.extra_r2) + " beyond g(q)), but in this motion the acceleration " +
+                 "follows the position (correlation " + num(correlation) +
+                 ", as with one sine per joint): either " + inertia_size_and_sign(delta) +
+                 ", or a gravity error that changes with the joint's angle (a centre of mass "
+                 "off); record a motion that moves joint " +
+                 std::to_string(joint) + " with several frequencies to tell them apart"});
+      } else if (inertia.extra_r2 >= kJointShare) {
         const double delta = -inertia.slope;
         check.patterns.push_back(
             {"inertia", joint, inertia.extra_r2,

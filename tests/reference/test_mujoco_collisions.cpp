@@ -472,8 +472,14 @@ TEST_F(MujocoCollisions, PandaCalibratedOnAFreeRunUnderEncoderQuantisation) {
     std::vector<Sample> samples;
     LogReader reader(dir_ / "free" / "log.csv", cfg.robot.model);
     for (Sample s; reader.next(s);) samples.push_back(s);
-    EstimatorOptions options =
-        apply_calibration(cfg.options, calibrate(cfg.robot.model, cfg.options, samples));
+    const Calibration cal = calibrate(cfg.robot.model, cfg.options, samples);
+    // The MJCF has no armature, and B's diagonal differs from the model's by ~1 % (the model
+    // error): the check must not name a rotor inertia on a joint that bears gravity, where in
+    // this motion of one sine per joint q̈ follows q and so does a gravity error of the model's
+    // perturbed centres of mass (it once named 0.15 kg m^2 on joint 2).
+    for (const ModelPattern& p : cal.model_check.patterns)
+      EXPECT_FALSE(p.kind == "inertia" && p.joint > 1) << scheme << ": " << p.message;
+    EstimatorOptions options = apply_calibration(cfg.options, cal);
     calibrated_schemes.emplace(scheme, Calibrated{std::move(cfg), std::move(options)});
   }
   int onsets_without_margin = 0;
