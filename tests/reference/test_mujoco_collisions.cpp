@@ -491,13 +491,15 @@ TEST_F(MujocoCollisions, PandaCalibratedOnAFreeRunUnderEncoderQuantisation) {
     for (const char* scheme : {"ft", "none"}) {
       const EstimatorConfig& cfg = calibrated_schemes.at(scheme).config;
       EstimatorOptions calibrated = calibrated_schemes.at(scheme).options;
+      double disagreement = 0.0;  // share of the contact samples flagged, last replay
       const auto replay = [&](const std::string& name, const EstimatorOptions& options) {
         ReplayOptions r;
         r.log = dir / "log.csv";
         r.out_dir = dir / name;
         r.figures = false;
         r.messages = &messages;
-        (void)replay_log(cfg.robot.model, cfg.robot.geometry, options, r);
+        disagreement =
+            replay_log(cfg.robot.model, cfg.robot.geometry, options, r).disagreement_fraction();
         return measure(r.log, r.out_dir / "estimates.csv");
       };
       const Figures defaults = measure(dir / "log.csv", dir / scheme / "estimates.csv");
@@ -516,6 +518,12 @@ TEST_F(MujocoCollisions, PandaCalibratedOnAFreeRunUnderEncoderQuantisation) {
       print_onsets("with the margin", f);
       const std::string where = std::string(scene) + " " + scheme;
       EXPECT_GT(defaults.false_alarms, 0) << where << ": the defaults stay quiet; no test here";
+      // One contact at a time: the sensor's wrench and the residual agree, to the wrench's own
+      // error, however low the calibrated thresholds (81 % of boxes' samples flagged when the
+      // agreement was judged against τ_thr alone, and the CLI blamed the sensor pose).
+      std::printf("  %s: disagreement on %.1f %% of the contact samples\n", where.c_str(),
+                  100.0 * disagreement);
+      EXPECT_LT(disagreement, 0.1) << where;
       // Without the margin only the spring-back's onsets are left, 90-160 ms after a push.
       for (const Figures::Onset& o : plain.false_onsets) EXPECT_LT(o.after_contact, 0.25) << where;
       onsets_without_margin += static_cast<int>(plain.false_onsets.size());
