@@ -373,12 +373,10 @@ void gravity_series(const Model& model, const std::vector<Sample>& samples, bool
       g[c] = gravity_torques(models[c], data[c], samples[k].q);
     forward_poses(model, poses, samples[k].q);  // the axes in W: S_i's angular part
     for (int i = 0; i < n; ++i) {
+      JointSeries& js = series[static_cast<std::size_t>(i)];
       const Vector3 axis = poses.S[static_cast<std::size_t>(i) + 1].tail<3>();
       if (g_norm > 0.0 && axis.cross(model.gravity).norm() > 1e-6 * g_norm * axis.norm())
-        series[static_cast<std::size_t>(i)].axis_along_gravity = false;
-    }
-    for (int i = 0; i < n; ++i) {
-      JointSeries& js = series[static_cast<std::size_t>(i)];
+        js.axis_along_gravity = false;
       js.gravity[k] = g[0][i];
       js.q[k] = samples[k].q[i];
       if (!payload_columns) continue;

@@ -1,7 +1,6 @@
 #include "friction_fit.hpp"
 
 #include <Eigen/Dense>
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -117,19 +116,24 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
   return f;
 }
 
-bool inertia_aliases_gravity(const JointSeries& s, const std::vector<char>& use,
-                             double& correlation) {
+std::vector<double> central_acceleration(const JointSeries& s) {
+  const std::size_t N = s.dq.size();
+  std::vector<double> acceleration(N, 0.0);
+  for (std::size_t k = 1; k + 1 < N; ++k)
+    acceleration[k] = (s.dq[k + 1] - s.dq[k - 1]) / (s.dt[k] + s.dt[k + 1]);
+  return acceleration;
+}
+
+bool inertia_aliases_gravity(const JointSeries& s, const std::vector<double>& acceleration,
+                             const std::vector<char>& use, double& correlation) {
   constexpr double kAliasCorrelation = 0.95;
   correlation = 0.0;
   const std::size_t N = s.dq.size();
-  if (s.axis_along_gravity || N < 3 || s.q.size() != N || s.dt.size() != N || use.size() != N)
+  if (s.axis_along_gravity || N < 3 || s.q.size() != N || acceleration.size() != N ||
+      use.size() != N)
     return false;
-  std::vector<double> acceleration(N, 0.0);
-  std::vector<char> inner(N, 0);  // the used samples with a central difference
-  for (std::size_t k = 1; k + 1 < N; ++k) {
-    acceleration[k] = (s.dq[k + 1] - s.dq[k - 1]) / (s.dt[k] + s.dt[k + 1]);
-    inner[k] = use[k];
-  }
+  std::vector<char> inner(use);  // the used samples with a central difference
+  inner[0] = inner[N - 1] = 0;
   const LineFit a = fit_line(s.q, acceleration, inner);
   if (a.sxx <= 1e-300 || a.syy <= 1e-300) return false;
   correlation = a.sxy / std::sqrt(a.sxx * a.syy);
@@ -271,7 +275,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   // One sine per joint: q̈ follows q, and an inertia cannot be told from a gravity error that
   // changes with q_i. Not applied; said, with what motion would tell them apart.
   double correlation = 0.0;
-  if (keep_inertia && inertia_aliases_gravity(s, use, correlation)) {
+  if (keep_inertia && inertia_aliases_gravity(s, central_acceleration(s), use, correlation)) {
     keep_inertia = false;
     best.warnings.push_back(
         j + ": an inertia correction (" + std::to_string(best_solve_with.theta[3]) +

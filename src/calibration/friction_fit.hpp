@@ -71,9 +71,13 @@ void apply_residual_filter(const std::vector<double>& weight, std::vector<double
 /// acceleration follows its position, |corr(q̈_i, q_i)| ≥ 0.95 over the used samples, as in a
 /// motion of one sine per joint (q̈ = −ω² (q − q0)). A gravity error that changes with q_i (a
 /// link's centre of mass off, not a multiple of the model's g_i) then looks like −δI q̈.
-/// `correlation` gets corr(q̈_i, q_i) (q̈ by central differences of q̇).
-[[nodiscard]] bool inertia_aliases_gravity(const JointSeries& s, const std::vector<char>& use,
-                                           double& correlation);
+/// `acceleration`: q̈_i (central_acceleration); `correlation` gets corr(q̈_i, q_i).
+[[nodiscard]] bool inertia_aliases_gravity(const JointSeries& s,
+                                           const std::vector<double>& acceleration,
+                                           const std::vector<char>& use, double& correlation);
+
+/// q̈_k by central differences of q̇, (q̇_{k+1} − q̇_{k−1}) / (Δt_k + Δt_{k+1}); 0 at both ends.
+[[nodiscard]] std::vector<double> central_acceleration(const JointSeries& s);
 
 /// Throws extwrench::Error when joint `joint` (1-based) does not move enough, in both
 /// directions, to identify its viscous and Coulomb friction over the samples in `use`.

@@ -94,7 +94,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
   const std::size_t n = series.size();
   const std::vector<double> suggested = residual_filter_weights(samples, kSuggestedCutoff);
   check.joint_rms = VectorX::Zero(static_cast<Eigen::Index>(n));
-  std::vector<double> phi, z, acc, z_acc;
+  std::vector<double> phi, z, z_acc;
   for (std::size_t i = 0; i < n; ++i) {
     const JointSeries& s = series[i];
     const int joint = static_cast<int>(i) + 1;
@@ -140,35 +140,33 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
                "; corrected by observer.inertia_correction, which removes " +
                num(100.0 * after[i].inertia_gain) + " % of what friction leaves"});
     } else {
-      acc.assign(s.dq.size(), 0.0);
-      for (std::size_t k = 1; k + 1 < s.dq.size(); ++k)
-        acc[k] = (s.dq[k + 1] - s.dq[k - 1]) / (samples[k + 1].t - samples[k - 1].t);
+      const std::vector<double> acc = central_acceleration(s);
       // Beyond g(q): in a periodic motion the position, hence a gravity error, follows q̈ too.
       filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
       const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
-      double correlation = 0.0;
-      if (inertia.extra_r2 >= kJointShare && inertia_aliases_gravity(s, use, correlation)) {
+      if (inertia.extra_r2 >= kJointShare) {
+        const double delta = -inertia.slope;
+        const std::string follows = "joint " + std::to_string(joint) +
+                                    ": the calibrated residual follows the joint's acceleration "
+                                    "(R^2 " +
+                                    num(inertia.extra_r2) + " beyond g(q))";
         // One sine per joint: q̈ follows q, and so does a gravity error that changes with q_i
-        // (not a multiple of g_i: a link's centre of mass off). Both named, and the remedy.
-        const double delta = -inertia.slope;
-        check.patterns.push_back(
-            {"inertia_or_gravity", joint, inertia.extra_r2,
-             "joint " + std::to_string(joint) +
-                 ": the calibrated residual follows the joint's acceleration (R^2 " +
-                 num(inertia.extra_r2) + " beyond g(q)), but in this motion the acceleration " +
-                 "follows the position (correlation " + num(correlation) +
-                 ", as with one sine per joint): either " + inertia_size_and_sign(delta) +
-                 ", or a gravity error that changes with the joint's angle (a centre of mass "
-                 "off); record a motion that moves joint " +
-                 std::to_string(joint) + " with several frequencies to tell them apart"});
-      } else if (inertia.extra_r2 >= kJointShare) {
-        const double delta = -inertia.slope;
-        check.patterns.push_back(
-            {"inertia", joint, inertia.extra_r2,
-             "joint " + std::to_string(joint) +
-                 ": the calibrated residual follows the joint's acceleration (R^2 " +
-                 num(inertia.extra_r2) + " beyond g(q)): " + inertia_size_and_sign(delta) +
-                 (delta > 0 ? "; armature: in the configuration" : "")});
+        // (not a multiple of g_i: a link's centre of mass off). Then both named, and the remedy.
+        double correlation = 0.0;
+        if (inertia_aliases_gravity(s, acc, use, correlation)) {
+          check.patterns.push_back(
+              {"inertia_or_gravity", joint, inertia.extra_r2,
+               follows + ", but in this motion the acceleration follows the position " +
+                   "(correlation " + num(correlation) + ", as with one sine per joint): either " +
+                   inertia_size_and_sign(delta) +
+                   ", or a gravity error that changes with the joint's angle (a centre of mass "
+                   "off); record a motion that moves joint " +
+                   std::to_string(joint) + " with several frequencies to tell them apart"});
+        } else {
+          check.patterns.push_back({"inertia", joint, inertia.extra_r2,
+                                    follows + ": " + inertia_size_and_sign(delta) +
+                                        (delta > 0 ? "; armature: in the configuration" : "")});
+        }
       }
     }
     // Mostly above ~20 Hz (unfiltered joints only): the velocity's noise through K B(q), or the
