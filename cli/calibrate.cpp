@@ -53,14 +53,16 @@ std::string cells(const Vector3& v) {
 }
 
 void print_report(const Calibration& c, const HoldoutReport* h, bool in_contact) {
-  std::cout << "  joint  viscous  Coulomb   offset      v_s  RMS before ->  after  var.expl  "
-               "threshold [N m]\n";
+  const bool dahl = c.friction.sign == SmoothSign::kDahl;
+  std::cout << "  joint  viscous  Coulomb   offset  " << (dahl ? "delta_q" : "    v_s")
+            << "  RMS before ->  after  var.expl  threshold [N m]\n";
   for (std::size_t i = 0; i < c.joints.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     const JointFitReport& j = c.joints[i];
     std::cout << "  " << std::left << std::setw(5) << i + 1 << std::right
               << cell(c.friction.viscous[k]) << " " << cell(c.friction.coulomb[k]) << " "
-              << cell(c.friction.offset[k]) << " " << cell(c.friction.smoothing(k)) << "  "
+              << cell(c.friction.offset[k]) << " "
+              << cell(dahl ? c.friction.presliding[k] : c.friction.smoothing(k)) << "  "
               << cell(j.rms_before) << " -> " << cell(j.rms_after, 6) << "  "
               << cell(j.variance_explained) << "  " << cell(j.threshold, 0);
     if (j.speed_dependent)
@@ -154,9 +156,15 @@ void run_calibrate(const CalibrateOptions& opt) {
     co.sign = SmoothSign::kTanh;
   } else if (opt.sign == "sigmoid") {
     co.sign = SmoothSign::kSigmoid;
+  } else if (opt.sign == "dahl") {
+    co.sign = SmoothSign::kDahl;
   } else {
-    throw UsageError("--sign: expected tanh or sigmoid, got '" + opt.sign + "'");
+    throw UsageError("--sign: expected tanh, sigmoid or dahl, got '" + opt.sign + "'");
   }
+  if (co.sign == SmoothSign::kDahl && opt.smoothing_velocity > 0)
+    throw UsageError(
+        "--smoothing-velocity: not used with --sign dahl (its presliding "
+        "displacement is chosen per joint)");
   if (opt.smoothing_velocity < 0) throw UsageError("--smoothing-velocity: expected a value >= 0");
   if (!(opt.false_alarms_per_hour > 0))
     throw UsageError("--false-alarms-per-hour: expected a value > 0");
@@ -228,7 +236,9 @@ void register_calibrate(CLI::App& app) {
                   "Fit on the first 1 - FRACTION of the log, report false alarms and detectable "
                   "forces on the rest (default 0)")
       ->type_name("FRACTION");
-  sub->add_option("--sign", opt->sign, "Smooth sign of the Coulomb term: tanh | sigmoid")
+  sub->add_option("--sign", opt->sign,
+                  "Sign of the Coulomb term: tanh | sigmoid (of the velocity) | dahl (lags a "
+                  "reversal by a presliding displacement; docs/calibration.md)")
       ->type_name("MODEL");
   sub->add_option("--smoothing-velocity", opt->smoothing_velocity,
                   "Coulomb smoothing velocity [rad/s] (default: chosen per joint)")

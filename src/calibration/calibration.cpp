@@ -23,6 +23,7 @@ using calibration_detail::JointSeries;
 constexpr double kSettleTimeConstants = 5.0;
 constexpr int kParametersPerJoint = 3;  // D, F_c, o
 constexpr double kWindowGap = 0.02;     // [s] flagged samples closer than this form one window
+constexpr double kReversalLead = 0.1;   // [s] a window this soon after its joint reversed
 constexpr double kMadToSigma = 1.4826;  // σ of a Gaussian from its median absolute deviation
 // ThresholdModel::kAuto takes a + b|q̇| when its mean over the motion is below this × the
 // constant threshold for the same rate.
@@ -386,6 +387,25 @@ void gravity_series(const Model& model, const std::vector<Sample>& samples, bool
   }
 }
 
+// Whether most windows hold a reversal of their joint's velocity (or begin within 0.1 s after
+// one): the signature of friction that lags the reversals (a Dahl sign), not of a contact.
+bool most_follow_reversals(const std::vector<SuspectWindow>& windows,
+                           const std::vector<Sample>& samples) {
+  std::size_t following = 0;
+  for (const SuspectWindow& w : windows) {
+    const auto i = static_cast<Eigen::Index>(w.joint - 1);
+    for (std::size_t k = 1; k < samples.size(); ++k) {
+      if (samples[k].t < w.t_begin - kReversalLead) continue;
+      if (samples[k].t > w.t_end) break;
+      if ((samples[k].dq[i] > 0.0) != (samples[k - 1].dq[i] > 0.0)) {
+        ++following;
+        break;
+      }
+    }
+  }
+  return 2 * following > windows.size();
+}
+
 // Marks the samples inside the windows (and one settle time after each) as unused.
 void exclude_windows(const std::vector<SuspectWindow>& windows, const std::vector<Sample>& samples,
                      double settle, std::vector<char>& use) {
@@ -406,7 +426,8 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
   cal.friction = JointFriction::none(n);
   cal.friction.sign = o.sign;
   cal.friction.offset = VectorX::Zero(n);
-  cal.friction.joint_smoothing = VectorX::Zero(n);
+  const bool dahl = o.sign == SmoothSign::kDahl;
+  (dahl ? cal.friction.presliding : cal.friction.joint_smoothing) = VectorX::Zero(n);
   if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift = VectorX::Zero(n);
   cal.tau_threshold = VectorX::Zero(n);
   cal.residual_noise = VectorX::Zero(n);
@@ -418,7 +439,7 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
     cal.friction.viscous[i] = f.viscous;
     cal.friction.coulomb[i] = f.coulomb;
     cal.friction.offset[i] = f.offset;
-    cal.friction.joint_smoothing[i] = f.smoothing;
+    (dahl ? cal.friction.presliding : cal.friction.joint_smoothing)[i] = f.smoothing;
     if (o.sign == SmoothSign::kSigmoid) cal.friction.velocity_shift[i] = f.shift;
     cal.inertia_correction[i] = f.inertia;
     for (const std::string& w : f.warnings) cal.warnings.push_back(w);
@@ -573,10 +594,16 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
       list += " [" + std::to_string(w.t_begin) + ", " + std::to_string(w.t_end) + "] s (joint " +
               std::to_string(w.joint) + ", " + std::to_string(w.peak) + " N m)";
     if (used - left > o.max_contact_fraction * used || left < parameters) {
+      std::string hint = "; record free motion only";
+      if (o.sign != SmoothSign::kDahl && most_follow_reversals(cal.suspect_windows, samples))
+        hint +=
+            ". Most windows begin as their joint reverses: friction that lags the "
+            "velocity's reversals looks like this (calibrate with --sign dahl, "
+            "docs/calibration.md)";
       throw Error(
           "calibration: the log does not look contact-free: the residual is far above "
           "its noise during" +
-          list + "; record free motion only");
+          list + hint);
     }
     cal.warnings.push_back(
         "possible contact (residual far above its noise), excluded from the "

@@ -15,6 +15,9 @@ namespace {
 // Grid of Coulomb smoothing velocities [rad/s] and sigmoid shifts [rad/s] searched per joint.
 constexpr std::array kSmoothingGrid{0.002, 0.005, 0.01, 0.02, 0.03, 0.05,
                                     0.075, 0.1,   0.15, 0.2,  0.3,  0.5};
+// Presliding displacements of the Dahl sign [rad]: a harmonic drive's stays within ~0.01 rad
+// (larger ones would fit slow parts of the motion, not the reversals).
+constexpr std::array kPreslidingGrid{0.0005, 0.001, 0.002, 0.003, 0.005, 0.007, 0.01};
 constexpr std::array kShiftGrid{-0.05, -0.04, -0.03, -0.02, -0.01, 0.0,
                                 0.01,  0.02,  0.03,  0.04,  0.05};
 // Motion needed to identify friction: a peak speed, and a share of the samples each way.
@@ -25,6 +28,24 @@ constexpr double kMaxCondition = 1e4;      // of the column-scaled regression
 constexpr double kMinInertiaGain = 0.1;
 
 std::string joint_name(int joint) { return "joint " + std::to_string(joint); }
+
+// The Coulomb term's regressor φ_k: the smooth sign of q̇_k, or the Dahl state over the joint's
+// positions from z = 0 at the first sample (as the observer after a reset), with `scale` = v_s
+// or δ.
+void coulomb_regressor(const JointSeries& s, SmoothSign sign, double scale, double shift,
+                       std::vector<double>& phi) {
+  const std::size_t N = s.dq.size();
+  phi.resize(N);
+  if (sign != SmoothSign::kDahl) {
+    for (std::size_t k = 0; k < N; ++k) phi[k] = smooth_sign(sign, s.dq[k], scale, shift);
+    return;
+  }
+  double z = 0.0;
+  for (std::size_t k = 0; k < N; ++k) {
+    if (k > 0) z = dahl_step(z, s.q[k] - s.q[k - 1], scale);
+    phi[k] = z;
+  }
+}
 
 // Least squares of r⁰ + Z θ ≈ 0 over the used samples, with the C columns in `active`.
 template <int C>
@@ -207,6 +228,8 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   const bool try_inertia = options.inertia_correction && !s.dt.empty();
   if (try_inertia) filter_rate(s.dq, s.alpha, s.dt, z_inertia, s.filter_weight);
   std::vector<double> smoothings(kSmoothingGrid.begin(), kSmoothingGrid.end());
+  if (options.sign == SmoothSign::kDahl)
+    smoothings.assign(kPreslidingGrid.begin(), kPreslidingGrid.end());
   if (options.smoothing_velocity > 0) smoothings = {options.smoothing_velocity};
   std::vector<double> shifts{0.0};
   if (options.sign == SmoothSign::kSigmoid) shifts.assign(kShiftGrid.begin(), kShiftGrid.end());
@@ -218,7 +241,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   Solve<4> best_solve_with;
   for (const double vs : smoothings) {
     for (const double shift : shifts) {
-      for (std::size_t k = 0; k < N; ++k) phi[k] = smooth_sign(options.sign, s.dq[k], vs, shift);
+      coulomb_regressor(s, options.sign, vs, shift, phi);
       filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
       const Solve<3> sol =
           solve_friction<3>({&z_viscous, &z_coulomb, &z_offset}, s.r0, use, options.regularisation);
@@ -259,8 +282,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
     filter_regressor(s.gravity, s.alpha, z_gravity[0], s.filter_weight);
     for (std::size_t c = 0; c < 4; ++c)
       filter_regressor(s.payload_gravity[c], s.alpha, z_gravity[c + 1], s.filter_weight);
-    for (std::size_t k = 0; k < N; ++k)
-      phi[k] = smooth_sign(options.sign, s.dq[k], best.smoothing, best.shift);
+    coulomb_regressor(s, options.sign, best.smoothing, best.shift, phi);
     filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
     const Solve<8> g =
         solve_friction<8>({&z_viscous, &z_coulomb, &z_offset, &z_gravity[0], &z_gravity[1],
@@ -296,8 +318,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   if (best.viscous == 0.0) best.warnings.push_back(j + ": viscous friction fitted < 0, set to 0");
   if (best.coulomb == 0.0) best.warnings.push_back(j + ": Coulomb friction fitted < 0, set to 0");
   // The residual with the chosen friction, over the whole log.
-  for (std::size_t k = 0; k < N; ++k)
-    phi[k] = smooth_sign(options.sign, s.dq[k], best.smoothing, best.shift);
+  coulomb_regressor(s, options.sign, best.smoothing, best.shift, phi);
   filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
   best.residual.resize(N);
   for (std::size_t k = 0; k < N; ++k)

@@ -27,6 +27,7 @@ struct JointSeries {
 
 /// The fitted friction of one joint and its fit statistics.
 struct JointFrictionFit {
+  /// smoothing: v_s [rad/s], or the Dahl sign's δ [rad].
   double viscous = 0.0, coulomb = 0.0, offset = 0.0, smoothing = 0.05, shift = 0.0;
   double inertia = 0.0;       ///< δI, the momentum's correction (0: not fitted) [kg m²]
   double inertia_gain = 0.0;  ///< share of friction's residual sum of squares it removed

@@ -12,18 +12,21 @@ namespace io_detail {
 JointFriction read_friction_mapping(const YamlReader& rd, const YAML::Node& f, int n,
                                     const std::string& key) {
   rd.only_keys(f, key,
-               {"sign", "viscous", "coulomb", "offset", "smoothing_velocity", "velocity_shift"});
+               {"sign", "viscous", "coulomb", "offset", "smoothing_velocity", "velocity_shift",
+                "presliding_displacement"});
   JointFriction jf = JointFriction::none(n);
   const Range coefficient = non_negative();
   const Range speed = positive();
   if (f["sign"]) {
     jf.sign = static_cast<SmoothSign>(
-        rd.one_of(f["sign"], key + ".sign", {"saturation", "tanh", "sigmoid"}));
+        rd.one_of(f["sign"], key + ".sign", {"saturation", "tanh", "sigmoid", "dahl"}));
   }
   if (f["viscous"]) jf.viscous = rd.vector(f["viscous"], key + ".viscous", n, &coefficient);
   if (f["coulomb"]) jf.coulomb = rd.vector(f["coulomb"], key + ".coulomb", n, &coefficient);
   if (f["offset"]) jf.offset = rd.vector(f["offset"], key + ".offset", n);
+  const bool dahl = jf.sign == SmoothSign::kDahl;
   if (const YAML::Node v = f["smoothing_velocity"]) {
+    if (dahl) rd.fail(v, key + ".smoothing_velocity", "not used with sign: dahl");
     if (v.IsSequence()) {
       jf.joint_smoothing = rd.vector(v, key + ".smoothing_velocity", n, &speed);
     } else {
@@ -34,6 +37,12 @@ JointFriction read_friction_mapping(const YamlReader& rd, const YAML::Node& f, i
     if (jf.sign != SmoothSign::kSigmoid)
       rd.fail(f["velocity_shift"], key + ".velocity_shift", "only used with sign: sigmoid");
     jf.velocity_shift = rd.vector(f["velocity_shift"], key + ".velocity_shift", n);
+  }
+  const YAML::Node presliding = f["presliding_displacement"];
+  if (dahl && !presliding) rd.fail(f, key, "sign: dahl needs presliding_displacement [rad | m]");
+  if (presliding) {
+    if (!dahl) rd.fail(presliding, key + ".presliding_displacement", "only used with sign: dahl");
+    jf.presliding = rd.vector(presliding, key + ".presliding_displacement", n, &speed);
   }
   return jf;
 }
@@ -58,7 +67,9 @@ std::string friction_mapping_yaml(const JointFriction& f) {
   if (f.sign != SmoothSign::kSaturation) y << "sign: " << to_string(f.sign) << ", ";
   y << "viscous: " << yaml_list(f.viscous) << ", coulomb: " << yaml_list(f.coulomb);
   if (f.offset.size() > 0) y << ", offset: " << yaml_list(f.offset);
-  if (f.joint_smoothing.size() > 0) {
+  if (f.sign == SmoothSign::kDahl) {
+    y << ", presliding_displacement: " << yaml_list(f.presliding);
+  } else if (f.joint_smoothing.size() > 0) {
     // Always a list: a single number would be read back as the shared smoothing velocity.
     y << ", smoothing_velocity: [";
     for (Eigen::Index i = 0; i < f.joint_smoothing.size(); ++i)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "extwrench/core/error.hpp"
 
@@ -34,6 +35,8 @@ std::string_view to_string(SmoothSign s) noexcept {
       return "tanh";
     case SmoothSign::kSigmoid:
       return "sigmoid";
+    case SmoothSign::kDahl:
+      return "dahl";
     case SmoothSign::kSaturation:
       break;
   }
@@ -46,10 +49,18 @@ double smooth_sign(SmoothSign sign, double dq, double smoothing, double shift) n
       return std::tanh(dq / smoothing);
     case SmoothSign::kSigmoid:
       return std::tanh((dq + shift) / smoothing) - std::tanh(shift / smoothing);
+    case SmoothSign::kDahl:
+      return dq > 0.0 ? 1.0 : (dq < 0.0 ? -1.0 : 0.0);
     case SmoothSign::kSaturation:
       break;
   }
   return std::clamp(dq / smoothing, -1.0, 1.0);
+}
+
+double dahl_step(double z, double displacement, double presliding) noexcept {
+  if (displacement == 0.0) return z;
+  const double s = displacement > 0.0 ? 1.0 : -1.0;
+  return s + (z - s) * std::exp(-std::abs(displacement) / presliding);
 }
 
 double smooth_sign(const JointFriction& friction, Eigen::Index i, double dq) noexcept {
@@ -73,6 +84,19 @@ void friction_torque(const JointFriction& friction, const Eigen::Ref<const Vecto
     const double offset = friction.offset.size() > 0 ? friction.offset[i] : 0.0;
     out[i] = friction.viscous[i] * dq[i] + friction.coulomb[i] * smooth_sign(friction, i, dq[i]) +
              offset;
+  }
+}
+
+void friction_torque(const JointFriction& friction, const Eigen::Ref<const VectorX>& dq,
+                     const Eigen::Ref<const VectorX>& presliding_state,
+                     Eigen::Ref<VectorX> out) noexcept {
+  if (friction.sign != SmoothSign::kDahl) {
+    friction_torque(friction, dq, out);
+    return;
+  }
+  for (Eigen::Index i = 0; i < dq.size(); ++i) {
+    const double offset = friction.offset.size() > 0 ? friction.offset[i] : 0.0;
+    out[i] = friction.viscous[i] * dq[i] + friction.coulomb[i] * presliding_state[i] + offset;
   }
 }
 
@@ -107,6 +131,17 @@ void validate_friction(const JointFriction& friction, int n, const std::string& 
   check_optional(friction.offset, "offset", false);
   check_optional(friction.joint_smoothing, "smoothing_velocity", true);
   check_optional(friction.velocity_shift, "velocity_shift", false);
+  check_optional(friction.presliding, "presliding_displacement", true);
+  const bool dahl = friction.sign == SmoothSign::kDahl;
+  if (dahl && friction.presliding.size() != n) {
+    throw Error(where + ": friction.presliding_displacement: expected " + std::to_string(n) +
+                " values > 0 with sign: dahl, got " + std::to_string(friction.presliding.size()));
+  }
+  if (!dahl && friction.presliding.size() != 0) {
+    throw Error(where +
+                ": friction.presliding_displacement: only used with sign: dahl, got sign: " +
+                std::string(to_string(friction.sign)));
+  }
   if (!(friction.smoothing_velocity > 0.0) || !std::isfinite(friction.smoothing_velocity)) {
     throw Error(where + ": friction.smoothing_velocity: expected a finite value > 0");
   }

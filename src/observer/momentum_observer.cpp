@@ -34,6 +34,7 @@ MomentumObserver::MomentumObserver(const Model& model, const VectorX& gains) : n
   friction_ = JointFriction::from_model(model);
   validate_friction(friction_, n_, "MomentumObserver: model '" + model.name + "'");
   r_ = VectorX::Zero(n_);
+  presliding_state_ = VectorX::Zero(n_);
   m_prev_ = VectorX::Zero(n_);
   gamma_prev_ = VectorX::Zero(n_);
   tau_prev_ = VectorX::Zero(n_);
@@ -56,7 +57,7 @@ void MomentumObserver::set_friction(const JointFriction& friction) {
   if (initialized_) {
     // γ_k = Cᵀq̇ − g − τ_f at sample k: swap the old τ_f(q̇_k) for the new one.
     gamma_ = tau_f_;
-    extwrench::friction_torque(friction_, dq_prev_, tau_f_);
+    extwrench::friction_torque(friction_, dq_prev_, presliding_state_, tau_f_);
     gamma_prev_ += gamma_ - tau_f_;
   }
 }
@@ -92,7 +93,7 @@ void MomentumObserver::set_offset(const Eigen::Ref<const VectorX>& offset) noexc
 }
 
 void MomentumObserver::integrand(const Data& data, const Eigen::Ref<const VectorX>& dq) noexcept {
-  extwrench::friction_torque(friction_, dq, tau_f_);
+  extwrench::friction_torque(friction_, dq, presliding_state_, tau_f_);
   // γ = Cᵀq̇ − g − τ_f: the state-dependent part of the integrand of (4).
   gamma_ = data.coriolis_transpose_dq - data.gravity_torque - tau_f_;
 }
@@ -120,6 +121,7 @@ Status MomentumObserver::reset(const Model& model, Data& data, double t,
   if (Status s = check_vector(dq, n_, Channel::kVelocity); !s.ok()) return s;
   // m = B q̇, Cᵀq̇ and g in one O(n) pass (eq. 4).
   momentum_terms(model, data, q, dq);
+  presliding_state_.setZero();  // the presliding state at rest is unknown: no friction
   integrand(data, dq);
   t_ = t;
   r_.setZero();
@@ -170,6 +172,11 @@ void MomentumObserver::integrate(const Data& data, double t, const Eigen::Ref<co
                                  const Eigen::Ref<const VectorX>& dq,
                                  const Eigen::Ref<const VectorX>& tau) noexcept {
   const double dt = t - t_;
+  if (friction_.sign == SmoothSign::kDahl) {
+    for (int i = 0; i < n_; ++i)
+      presliding_state_[i] =
+          dahl_step(presliding_state_[i], q[i] - q_prev_[i], friction_.presliding[i]);
+  }
   integrand(data, dq);
   if (dt != alpha_dt_) {
     alpha_ = (-gains_ * dt).array().exp();  // e^{−K Δt}, recomputed only when Δt changes

@@ -15,9 +15,20 @@
 
 namespace extwrench::test {
 
+/// presliding (when not empty): a Dahl sign with these δ_i [rad] instead of tanh(q̇ / v_s).
 struct TrueFriction {
-  VectorX viscous, coulomb, offset, smoothing;
+  VectorX viscous, coulomb, offset, smoothing, presliding;
 };
+
+/// The Dahl state after a displacement, by 200 explicit Euler steps of dz/dq = (sign − z) / δ:
+/// a numerical integration of the model's equation, independent of the library's closed form.
+inline double dahl_euler(double z, double displacement, double presliding) {
+  if (displacement == 0.0) return z;
+  const double s = displacement > 0.0 ? 1.0 : -1.0;
+  const double h = std::abs(displacement) / 200.0;
+  for (int k = 0; k < 200; ++k) z += h * (s - z) / presliding;
+  return z;
+}
 
 inline TrueFriction paper_arm_friction() {
   TrueFriction f;
@@ -93,11 +104,19 @@ inline std::vector<Sample> simulate_free_motion(
   std::vector<Sample> samples;
   samples.reserve(static_cast<std::size_t>(simulator.num_samples()));
   Sample s;
+  VectorX dahl = VectorX::Zero(7);  // the Dahl states, from rest
   while (simulator.next(s)) {
     for (int i = 0; i < 7; ++i) {
       const double dq = s.dq[i];
-      s.tau[i] += friction.viscous[i] * dq +
-                  friction.coulomb[i] * std::tanh(dq / friction.smoothing[i]) + friction.offset[i] +
+      double sign = 0.0;
+      if (friction.presliding.size() > 0) {
+        if (!samples.empty())
+          dahl[i] = dahl_euler(dahl[i], s.q[i] - samples.back().q[i], friction.presliding[i]);
+        sign = dahl[i];
+      } else {
+        sign = std::tanh(dq / friction.smoothing[i]);
+      }
+      s.tau[i] += friction.viscous[i] * dq + friction.coulomb[i] * sign + friction.offset[i] +
                   (tau_noise + tau_noise_per_speed * std::abs(dq)) * rng.normal();
     }
     samples.push_back(s);

@@ -3,6 +3,7 @@
 // through an estimator configuration, and the calibrated estimator's real-time contract.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -32,6 +33,39 @@ std::vector<Sample> free_log(double seconds, std::vector<sim::ForceProfile> forc
                                                                                              1.0)) {
   return test::simulate_free_motion(paper_arm(), trajectory, test::paper_arm_friction(), seconds,
                                     Vector6::Zero(), 0.02, 5, std::move(forces));
+}
+
+// `cal` written to DIR/calib.yaml (DIR a temporary directory) and included by a configuration of
+// the paper arm without a sensor, K = 50, DIR/config.yaml.
+EstimatorConfig config_including(const Calibration& cal, const char* dir_name) {
+  const fs::path dir = fs::temp_directory_path() / dir_name;
+  fs::create_directories(dir);
+  std::ofstream(dir / "calib.yaml") << calibration_to_yaml(cal, nullptr);
+  const std::string robot = (fs::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf").string();
+  return load_estimator_config_string(
+      "robot: " + robot + "\nsensor: {type: none}\nobserver: {gain: 50}\ncalibration: calib.yaml\n",
+      dir / "config.yaml");
+}
+
+// The RMS per joint of the residual of a MomentumObserver (K = 50) run over `log` with the
+// calibrated friction, over the samples the calibration used (after its settle time, 5 / K).
+VectorX observer_rms_after_settling(const Model& model, const Calibration& cal,
+                                    const std::vector<Sample>& log) {
+  Data data(model);
+  MomentumObserver observer(model, 50.0);
+  observer.set_friction(cal.friction);
+  EXPECT_TRUE(observer.reset(model, data, log[0].t, log[0].q, log[0].dq, log[0].tau).ok());
+  VectorX sum2 = VectorX::Zero(model.nq());
+  int count = 0;
+  for (std::size_t k = 1; k < log.size(); ++k) {
+    EXPECT_TRUE(observer.update(model, data, log[k].t, log[k].q, log[k].dq, log[k].tau).ok());
+    EXPECT_LE(observer.presliding_state().cwiseAbs().maxCoeff(), 1.0);
+    if (log[k].t < 5.0 / 50.0 - 1e-9) continue;
+    sum2 += observer.residual().cwiseAbs2();
+    ++count;
+  }
+  EXPECT_EQ(count, cal.samples_used);
+  return (sum2 / std::max(count, 1)).cwiseSqrt();
 }
 
 // Gaz et al. (2019): τ_f = A / (1 + e^{−α (q̇ + φ)}) − A / (1 + e^{−α φ}), here with A = 2 F_c
@@ -65,28 +99,99 @@ TEST(FrictionModel, OffsetAndTanhAddUp) {
   EXPECT_FALSE(f.is_zero());
 }
 
+// The Dahl sign's state against the solution of its equation dz/dq = (sign(Δq) − z) / δ for a
+// motion of one direction, z = s + (z₀ − s) e^{−|q − q₀|/δ}: exact whatever the steps (one
+// displacement or a thousand), and after a reversal it needs about δ ln 2 to cross zero.
+TEST(FrictionModel, DahlStateIsTheSolutionOfItsEquationAtAnyStep) {
+  const double delta = 0.004;
+  double one_step = dahl_step(0.0, 0.01, delta), many = 0.0;
+  for (int k = 0; k < 1000; ++k) many = dahl_step(many, 1e-5, delta);
+  EXPECT_NEAR(one_step, 1.0 - std::exp(-0.01 / delta), 1e-15);
+  EXPECT_NEAR(many, 1.0 - std::exp(-0.01 / delta), 1e-13);
+  // A reversal from the steady state: -1 + 2 e^{-d/δ}, zero at d = δ ln 2.
+  EXPECT_NEAR(dahl_step(1.0, -0.003, delta), -1.0 + 2.0 * std::exp(-0.003 / delta), 1e-15);
+  EXPECT_NEAR(dahl_step(1.0, -delta * std::log(2.0), delta), 0.0, 1e-15);
+  EXPECT_EQ(dahl_step(0.37, 0.0, delta), 0.37);  // at rest the state holds
+  EXPECT_EQ(test::dahl_euler(0.37, 0.0, delta), 0.37);
+  // The explicit Euler integration of the test's simulator agrees to its own accuracy.
+  EXPECT_NEAR(test::dahl_euler(-0.5, 0.006, delta), dahl_step(-0.5, 0.006, delta), 1e-2);
+  // τ_f with the state: D q̇ + F_c z + o; without a state its steady state, sign(q̇).
+  JointFriction f = JointFriction::none(1);
+  f.sign = SmoothSign::kDahl;
+  f.viscous[0] = 0.2;
+  f.coulomb[0] = 0.5;
+  f.offset = VectorX::Constant(1, 0.1);
+  f.presliding = VectorX::Constant(1, delta);
+  EXPECT_NO_THROW(validate_friction(f, 1, "test"));
+  VectorX out(1);
+  friction_torque(f, VectorX::Constant(1, -0.3), VectorX::Constant(1, 0.25), out);
+  EXPECT_NEAR(out[0], 0.2 * -0.3 + 0.5 * 0.25 + 0.1, 1e-15);
+  friction_torque(f, VectorX::Constant(1, -0.3), out);
+  EXPECT_NEAR(out[0], 0.2 * -0.3 - 0.5 + 0.1, 1e-15);
+  // δ is required with the Dahl sign and refused without it.
+  f.presliding.resize(0);
+  EXPECT_THROW(validate_friction(f, 1, "test"), Error);
+  f.sign = SmoothSign::kTanh;
+  f.presliding = VectorX::Constant(1, delta);
+  EXPECT_THROW(validate_friction(f, 1, "test"), Error);
+}
+
+// A robot whose Coulomb friction lags its reversals (a Dahl sign): calibrate --sign dahl finds
+// its friction within acceptance 1's 5 % and its presliding displacement; a velocity sign (tanh)
+// cannot follow it and takes the reversals for contacts, and the refusal says what they are.
+// The observer run with the fitted friction leaves exactly the residual the fit reports.
+TEST(Calibration, DahlFrictionIsIdentifiedWhereAVelocitySignCannotFollowIt) {
+  const Model model = paper_arm();
+  test::TrueFriction truth = test::paper_arm_friction();
+  truth.presliding = VectorX::Constant(7, 0.003);
+  const std::vector<Sample> log = test::simulate_free_motion(
+      model, test::free_motion(0.0, 1.0), truth, 20.0, Vector6::Zero(), 0.02, 17);
+  CalibrationOptions dahl;
+  dahl.sign = SmoothSign::kDahl;
+  const Calibration cal = calibrate(model, no_sensor(), log, dahl);
+  ASSERT_EQ(cal.friction.sign, SmoothSign::kDahl);
+  ASSERT_EQ(cal.friction.presliding.size(), 7);
+  EXPECT_EQ(cal.friction.joint_smoothing.size(), 0);
+  EXPECT_TRUE(cal.suspect_windows.empty());
+  for (int i = 0; i < 7; ++i) {
+    SCOPED_TRACE("joint " + std::to_string(i + 1));
+    EXPECT_NEAR(cal.friction.coulomb[i], truth.coulomb[i], 0.05 * truth.coulomb[i]);
+    EXPECT_NEAR(cal.friction.viscous[i], truth.viscous[i], 0.05 * truth.viscous[i]);
+    EXPECT_NEAR(cal.friction.offset[i], truth.offset[i], 0.02);
+    EXPECT_NEAR(cal.friction.presliding[i], 0.003, 1e-12);
+    EXPECT_GT(cal.joints[static_cast<std::size_t>(i)].variance_explained, 0.9);
+  }
+  try {
+    (void)calibrate(model, no_sensor(), log);
+    FAIL() << "a velocity sign calibrated a lagging friction";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("does not look contact-free"), std::string::npos) << what;
+    EXPECT_NE(what.find("--sign dahl"), std::string::npos) << what;
+  }
+  // The observer with the fitted Dahl friction (its own state, from the positions) leaves the
+  // residual the fit reports.
+  const VectorX rms = observer_rms_after_settling(model, cal, log);
+  for (int i = 0; i < 7; ++i)
+    EXPECT_NEAR(rms[i], cal.joints[static_cast<std::size_t>(i)].rms_after, 1e-9);
+  // Through CALIB.yaml: written, included by a configuration, the same friction.
+  const EstimatorConfig cfg = config_including(cal, "extwrench_calibration_dahl");
+  ASSERT_TRUE(cfg.options.friction.has_value());
+  EXPECT_EQ(cfg.options.friction->sign, SmoothSign::kDahl);
+  EXPECT_EQ(cfg.options.friction->presliding, cal.friction.presliding);
+  EXPECT_EQ(cfg.options.friction->coulomb, cal.friction.coulomb);
+  EXPECT_EQ(cfg.options.friction->joint_smoothing.size(), 0);
+}
+
 // The least squares works on r⁰ + Σ θ z (calibration.hpp); the observer itself, run with the
 // fitted friction, must leave exactly the residual the fit reports.
 TEST(Calibration, FitResidualIsTheObserverResidualWithTheFittedFriction) {
   const Model model = paper_arm();
   const auto log = free_log(12.0);
   const Calibration cal = calibrate(model, no_sensor(), log);
-  Data data(model);
-  MomentumObserver observer(model, 50.0);
-  observer.set_friction(cal.friction);
-  ASSERT_TRUE(observer.reset(model, data, log[0].t, log[0].q, log[0].dq, log[0].tau).ok());
-  VectorX sum2 = VectorX::Zero(7);
-  int count = 0;
-  for (std::size_t k = 1; k < log.size(); ++k) {
-    ASSERT_TRUE(observer.update(model, data, log[k].t, log[k].q, log[k].dq, log[k].tau).ok());
-    if (log[k].t < 5.0 / 50.0 - 1e-9) continue;
-    sum2 += observer.residual().cwiseAbs2();
-    ++count;
-  }
-  ASSERT_EQ(count, cal.samples_used);
+  const VectorX rms = observer_rms_after_settling(model, cal, log);
   for (int i = 0; i < 7; ++i) {
-    EXPECT_NEAR(std::sqrt(sum2[i] / count), cal.joints[static_cast<std::size_t>(i)].rms_after,
-                1e-9);
+    EXPECT_NEAR(rms[i], cal.joints[static_cast<std::size_t>(i)].rms_after, 1e-9);
     EXPECT_LT(cal.joints[static_cast<std::size_t>(i)].rms_after,
               0.2 * cal.joints[static_cast<std::size_t>(i)].rms_before);
   }
@@ -207,12 +312,8 @@ TEST(CalibrationFile, IncludedByAConfigurationGivesTheSameOptions) {
   Calibration cal = calibrate(model, no_sensor(), free_log(8.0));
   cal.source = "free.csv";
   const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_file";
-  fs::create_directories(dir);
-  std::ofstream(dir / "calib.yaml") << calibration_to_yaml(cal, nullptr);
   const std::string robot = (fs::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf").string();
-  const EstimatorConfig cfg = load_estimator_config_string(
-      "robot: " + robot + "\nsensor: {type: none}\nobserver: {gain: 50}\ncalibration: calib.yaml\n",
-      dir / "config.yaml");
+  const EstimatorConfig cfg = config_including(cal, "extwrench_calibration_file");
   ASSERT_TRUE(cfg.options.friction.has_value());
   EXPECT_EQ(cfg.options.friction->sign, SmoothSign::kTanh);
   EXPECT_TRUE(cfg.options.friction->offset.isApprox(cal.friction.offset, 1e-15));
@@ -242,12 +343,18 @@ TEST(CalibratedEstimator, UpdateAllocatesNothing) {
                                  3.0, Vector6::Zero(), 0.02, 3);
   CalibrationOptions speed;
   speed.thresholds = ThresholdModel::kSpeed;  // thresholds a + b|q̇| on every joint
-  // Constant thresholds, thresholds a + b|q̇|, and constant ones with drift tracking on.
-  for (int variant = 0; variant < 3; ++variant) {
+  // Constant thresholds, thresholds a + b|q̇|, constant ones with drift tracking on, and the
+  // calibrated friction with a Dahl sign (the observer's state).
+  for (int variant = 0; variant < 4; ++variant) {
     const Calibration cal =
         calibrate(model, options, log, variant == 1 ? speed : CalibrationOptions{});
     EstimatorOptions calibrated = apply_calibration(options, cal);
     if (variant == 2) calibrated.drift = DriftOptions{};
+    if (variant == 3) {
+      calibrated.friction->sign = SmoothSign::kDahl;
+      calibrated.friction->joint_smoothing.resize(0);
+      calibrated.friction->presliding = VectorX::Constant(7, 0.003);
+    }
     ContactEstimator est(model, GeometryModel{}, calibrated);
     ASSERT_TRUE(est.reset(log.front()).ok());
     const test::AllocationCounter counter;

@@ -233,6 +233,17 @@ INSTANTIATE_TEST_SUITE_P(
                   "expected one of residual, differentiation, got 'integrate'"},
         BadConfig{"sensor: {type: ft}\nfriction: {viscous: [1, 2]}\n", ":3:", "friction.viscous",
                   "7 values"},
+        BadConfig{"sensor: {type: ft}\nfriction: {sign: dahl, viscous: 0, coulomb: 0.2}\n",
+                  ":3:", "friction", "sign: dahl needs presliding_displacement"},
+        BadConfig{"sensor: {type: ft}\nfriction: {sign: tanh, viscous: 0, coulomb: 0.2,\n"
+                  "  presliding_displacement: 0.002}\n",
+                  ":4:", "friction.presliding_displacement", "only used with sign: dahl"},
+        BadConfig{"sensor: {type: ft}\nfriction: {sign: dahl, viscous: 0, coulomb: 0.2,\n"
+                  "  presliding_displacement: [0.002, 0, 0.002, 0.002, 0.002, 0.002, 0.002]}\n",
+                  ":4:", "friction.presliding_displacement[1]", "> 0"},
+        BadConfig{"sensor: {type: ft}\nfriction: {sign: dahl, viscous: 0, coulomb: 0.2,\n"
+                  "  presliding_displacement: 0.002, smoothing_velocity: 0.01}\n",
+                  ":4:", "friction.smoothing_velocity", "not used with sign: dahl"},
         BadConfig{"sensor: {type: ft}\npayload: {link: link7, mass: -1}\n", ":3:", "payload.mass",
                   ">= 0"},
         BadConfig{

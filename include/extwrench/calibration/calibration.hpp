@@ -12,7 +12,8 @@
 // (same exact first-order discretisation and trapezoidal rule as the observer), so the θ that
 // makes the residual of a contact-free log smallest is a linear least-squares problem per joint,
 // solved with a small ridge term on column-scaled regressors. The Coulomb smoothing velocity
-// (and the sigmoid's shift) enters non-linearly: it is chosen per joint on a grid, or set.
+// (and the sigmoid's shift, or the Dahl sign's presliding displacement) enters non-linearly: it
+// is chosen per joint on a grid, or set.
 #pragma once
 
 #include <string>
@@ -33,8 +34,8 @@ enum class ThresholdModel {
 
 struct CalibrationOptions {
   ThresholdModel thresholds = ThresholdModel::kAuto;
-  SmoothSign sign = SmoothSign::kTanh;  ///< tanh or sigmoid (saturation also accepted)
-  double smoothing_velocity = 0.0;      ///< > 0: v_s fixed [rad/s]; 0: chosen per joint
+  SmoothSign sign = SmoothSign::kTanh;  ///< tanh, sigmoid or dahl (saturation also accepted)
+  double smoothing_velocity = 0.0;      ///< > 0: v_s fixed [rad/s] (dahl: δ [rad]); 0: per joint
   double false_alarms_per_hour = 1.0;   ///< target rate of the thresholds, all joints together
   double threshold_margin = 1.1;        ///< thresholds ≥ margin × the largest fitted residual
   double regularisation = 1e-9;         ///< ridge λ relative to the scaled normal matrix

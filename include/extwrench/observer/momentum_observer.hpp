@@ -110,6 +110,9 @@ class MomentumObserver {
   [[nodiscard]] const JointFriction& friction() const noexcept { return friction_; }
   /// Friction torques τ_f(q̇) of the last sample (n).
   [[nodiscard]] const VectorX& friction_torque() const noexcept { return tau_f_; }
+  /// The Dahl sign's state z_i of the last sample (n; zero after reset, and unless the
+  /// friction's sign is kDahl).
+  [[nodiscard]] const VectorX& presliding_state() const noexcept { return presliding_state_; }
   [[nodiscard]] int nq() const noexcept { return n_; }
 
  private:
@@ -127,10 +130,11 @@ class MomentumObserver {
   bool initialized_ = false;
   bool have_tau_ = false;  ///< tau_prev_ holds the torque of the current interval
   double t_ = 0.0;
-  VectorX r_;           ///< residual r_k
-  VectorX m_prev_;      ///< m_k = B(q_k) q̇_k + δI q̇_k
-  VectorX gamma_prev_;  ///< γ_k = Cᵀq̇ − g − τ_f at sample k
-  VectorX tau_prev_;    ///< τ_k (held over [t_k, t_{k+1}))
+  VectorX r_;                 ///< residual r_k
+  VectorX presliding_state_;  ///< the Dahl sign's z_k (friction.hpp)
+  VectorX m_prev_;            ///< m_k = B(q_k) q̇_k + δI q̇_k
+  VectorX gamma_prev_;        ///< γ_k = Cᵀq̇ − g − τ_f at sample k
+  VectorX tau_prev_;          ///< τ_k (held over [t_k, t_{k+1}))
   VectorX q_prev_, dq_prev_;
 
   // Cached e^{−K Δt} for the last Δt (uniform sampling computes the exponentials once).
