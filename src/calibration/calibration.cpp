@@ -597,7 +597,7 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
       std::string hint = "; record free motion only";
       if (o.sign != SmoothSign::kDahl && most_follow_reversals(cal.suspect_windows, samples))
         hint +=
-            ". Most windows begin as their joint reverses: friction that lags the "
+            ". Most windows hold a reversal of their joint's velocity: friction that lags the "
             "velocity's reversals looks like this (calibrate with --sign dahl, "
             "docs/calibration.md)";
       throw Error(

@@ -68,6 +68,17 @@ double smooth_sign(const JointFriction& friction, Eigen::Index i, double dq) noe
   return smooth_sign(friction.sign, dq, friction.smoothing(i), shift);
 }
 
+namespace {
+
+// D_i q̇ + F_c,i s + o_i of joint i, for the Coulomb sign s.
+double joint_friction(const JointFriction& friction, Eigen::Index i, double dq,
+                      double sign) noexcept {
+  const double offset = friction.offset.size() > 0 ? friction.offset[i] : 0.0;
+  return friction.viscous[i] * dq + friction.coulomb[i] * sign + offset;
+}
+
+}  // namespace
+
 void friction_torque(const JointFriction& friction, const Eigen::Ref<const VectorX>& dq,
                      Eigen::Ref<VectorX> out) noexcept {
   const bool plain = friction.sign == SmoothSign::kSaturation && friction.offset.size() == 0 &&
@@ -80,11 +91,8 @@ void friction_torque(const JointFriction& friction, const Eigen::Ref<const Vecto
     }
     return;
   }
-  for (Eigen::Index i = 0; i < dq.size(); ++i) {
-    const double offset = friction.offset.size() > 0 ? friction.offset[i] : 0.0;
-    out[i] = friction.viscous[i] * dq[i] + friction.coulomb[i] * smooth_sign(friction, i, dq[i]) +
-             offset;
-  }
+  for (Eigen::Index i = 0; i < dq.size(); ++i)
+    out[i] = joint_friction(friction, i, dq[i], smooth_sign(friction, i, dq[i]));
 }
 
 void friction_torque(const JointFriction& friction, const Eigen::Ref<const VectorX>& dq,
@@ -94,10 +102,8 @@ void friction_torque(const JointFriction& friction, const Eigen::Ref<const Vecto
     friction_torque(friction, dq, out);
     return;
   }
-  for (Eigen::Index i = 0; i < dq.size(); ++i) {
-    const double offset = friction.offset.size() > 0 ? friction.offset[i] : 0.0;
-    out[i] = friction.viscous[i] * dq[i] + friction.coulomb[i] * presliding_state[i] + offset;
-  }
+  for (Eigen::Index i = 0; i < dq.size(); ++i)
+    out[i] = joint_friction(friction, i, dq[i], presliding_state[i]);
 }
 
 void validate_friction(const JointFriction& friction, int n, const std::string& where) {
