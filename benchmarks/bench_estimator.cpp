@@ -3,6 +3,7 @@
 #include <benchmark/benchmark.h>
 
 #include <kdl/chainexternalwrenchestimator.hpp>
+#include <optional>
 
 #include "extwrench/observer/momentum_observer.hpp"
 #include "robots.hpp"
@@ -42,11 +43,14 @@ void BM_ExtWrench_Kdl(benchmark::State& state) {
 }
 BENCHMARK(BM_ExtWrench_Kdl);
 
-// The momentum residual (4) alone: O(n) momentum terms + the exact first-order update.
-void BM_Residual_Ours(benchmark::State& state) {
+// The momentum residual (4) alone: O(n) momentum terms + the exact first-order update; with a
+// calibrated friction (`friction`: tanh, or the Dahl sign and its state, advanced every sample)
+// on every joint. The observer has no branch on the residual: the same path with any friction.
+void residual_update(benchmark::State& state, const std::optional<JointFriction>& friction) {
   const PaperArm& arm = paper_arm();
   const Trajectory& tr = flange_trajectory();
   MomentumObserver observer(arm.model, kGain);
+  if (friction) observer.set_friction(*friction);
   Data data(arm.model);
   if (!observer.reset(arm.model, data, 0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok()) {
     state.SkipWithError("reset failed");
@@ -63,7 +67,31 @@ void BM_Residual_Ours(benchmark::State& state) {
   state.counters["allocs"] =
       allocations_per_call([&](int i) { call(static_cast<std::size_t>(i)); });
 }
+
+JointFriction calibrated_friction(int n, SmoothSign sign) {
+  JointFriction f = JointFriction::none(n);
+  f.sign = sign;
+  f.viscous = VectorX::Constant(n, 0.01);
+  f.coulomb = VectorX::Constant(n, 0.3);
+  f.offset = VectorX::Constant(n, 0.01);
+  if (sign == SmoothSign::kDahl) {
+    f.presliding = VectorX::Constant(n, 0.005);
+  } else {
+    f.joint_smoothing = VectorX::Constant(n, 0.05);
+  }
+  return f;
+}
+
+void BM_Residual_Ours(benchmark::State& state) { residual_update(state, std::nullopt); }
 BENCHMARK(BM_Residual_Ours);
+void BM_Residual_Ours_TanhFriction(benchmark::State& state) {
+  residual_update(state, calibrated_friction(paper_arm().model.nq(), SmoothSign::kTanh));
+}
+BENCHMARK(BM_Residual_Ours_TanhFriction);
+void BM_Residual_Ours_DahlFriction(benchmark::State& state) {
+  residual_update(state, calibrated_friction(paper_arm().model.nq(), SmoothSign::kDahl));
+}
+BENCHMARK(BM_Residual_Ours_DahlFriction);
 
 }  // namespace
 }  // namespace extwrench::bench

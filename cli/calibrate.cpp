@@ -24,6 +24,7 @@ struct CalibrateOptions {
   double holdout = 0.0;
   std::string sign = "tanh";
   double smoothing_velocity = 0.0;
+  double presliding_displacement = 0.0;
   double false_alarms_per_hour = 1.0;
   std::string thresholds = "auto";
   bool payload = false;
@@ -164,11 +165,17 @@ void run_calibrate(const CalibrateOptions& opt) {
   if (co.sign == SmoothSign::kDahl && opt.smoothing_velocity > 0)
     throw UsageError(
         "--smoothing-velocity: not used with --sign dahl (its presliding "
-        "displacement is chosen per joint)");
+        "displacement is chosen per joint, or fixed by --presliding-displacement)");
+  if (co.sign != SmoothSign::kDahl && opt.presliding_displacement > 0)
+    throw UsageError("--presliding-displacement: only with --sign dahl");
   if (opt.smoothing_velocity < 0) throw UsageError("--smoothing-velocity: expected a value >= 0");
+  if (opt.presliding_displacement < 0)
+    throw UsageError("--presliding-displacement: expected a value >= 0");
   if (!(opt.false_alarms_per_hour > 0))
     throw UsageError("--false-alarms-per-hour: expected a value > 0");
-  co.smoothing_velocity = opt.smoothing_velocity;
+  // The library's one fixed scale: v_s, or δ with the Dahl sign.
+  co.smoothing_velocity =
+      co.sign == SmoothSign::kDahl ? opt.presliding_displacement : opt.smoothing_velocity;
   co.payload = opt.payload;
   co.known_external_torque = opt.known_torque;
   co.inertia_correction = opt.inertia;
@@ -243,6 +250,10 @@ void register_calibrate(CLI::App& app) {
   sub->add_option("--smoothing-velocity", opt->smoothing_velocity,
                   "Coulomb smoothing velocity [rad/s] (default: chosen per joint)")
       ->type_name("V");
+  sub->add_option("--presliding-displacement", opt->presliding_displacement,
+                  "With --sign dahl: presliding displacement [rad] (default: chosen per joint "
+                  "from 0.5 to 10 mrad)")
+      ->type_name("D");
   sub->add_option("--false-alarms-per-hour", opt->false_alarms_per_hour,
                   "False-alarm rate the thresholds are set for (default 1)")
       ->type_name("RATE");

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <tuple>
+#include <utility>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/observer/residual_filter.hpp"
@@ -105,6 +107,52 @@ Solve<C> solve_friction(const std::array<const std::vector<double>*, C>& z,
     sol = solve<C>(z, r0, use, active, lambda);
   }
   return sol;
+}
+
+// Sum of squares and largest |r| of r⁰ + D z_D + F_c z_c + o z_o over the used samples.
+std::pair<double, double> residual_size(const std::vector<double>& r0, const Eigen::Vector3d& theta,
+                                        const std::vector<double>& z_viscous,
+                                        const std::vector<double>& z_coulomb,
+                                        const std::vector<double>& z_offset,
+                                        const std::vector<char>& use) {
+  double rss = 0.0, peak = 0.0;
+  for (std::size_t k = 0; k < r0.size(); ++k) {
+    if (!use[k]) continue;
+    const double r =
+        r0[k] + theta[0] * z_viscous[k] + theta[1] * z_coulomb[k] + theta[2] * z_offset[k];
+    rss += r * r;
+    peak = std::max(peak, std::abs(r));
+  }
+  return {rss, peak};
+}
+
+// The friction fit with the sign (θ, v_s, shift given) beside the best one with the Dahl sign.
+DahlAlternative dahl_alternative(const JointSeries& s, const std::vector<char>& use,
+                                 double regularisation, const Eigen::Vector3d& sign_theta,
+                                 double smoothing, double shift, SmoothSign sign,
+                                 const std::vector<double>& z_viscous,
+                                 const std::vector<double>& z_offset) {
+  DahlAlternative out;
+  std::vector<double> phi, z_coulomb;
+  coulomb_regressor(s, sign, smoothing, shift, phi);
+  filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
+  std::tie(out.sign_rss, out.sign_peak) =
+      residual_size(s.r0, sign_theta, z_viscous, z_coulomb, z_offset, use);
+  Solve<3> best;
+  for (const double delta : kPreslidingGrid) {
+    coulomb_regressor(s, SmoothSign::kDahl, delta, 0.0, phi);
+    filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
+    const Solve<3> sol =
+        solve_friction<3>({&z_viscous, &z_coulomb, &z_offset}, s.r0, use, regularisation);
+    if (sol.rss >= best.rss) continue;
+    best = sol;
+    out.presliding = delta;
+  }
+  coulomb_regressor(s, SmoothSign::kDahl, out.presliding, 0.0, phi);
+  filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
+  std::tie(out.rss, out.peak) =
+      residual_size(s.r0, best.theta, z_viscous, z_coulomb, z_offset, use);
+  return out;
 }
 
 }  // namespace
@@ -261,6 +309,9 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
     }
   }
   const std::string j = joint_name(joint);
+  if (options.sign != SmoothSign::kDahl && !s.q.empty())
+    best.dahl = dahl_alternative(s, use, options.regularisation, best_solve.theta, best.smoothing,
+                                 best.shift, options.sign, z_viscous, z_offset);
   if (best_solve.condition > kMaxCondition) {
     throw Error(j + ": viscous friction, Coulomb friction and offset cannot be told apart " +
                 "(condition " + std::to_string(best_solve.condition) + "); record a motion of " +

@@ -25,6 +25,16 @@ struct JointSeries {
   bool axis_along_gravity = false;
 };
 
+/// The same friction (D, F_c, o; no inertia correction) with the sign fitted and with the Dahl
+/// sign instead, over the used samples: the residual's sum of squares and largest |r| of each,
+/// and the Dahl fit's δ. Computed for a sign of q̇ (tanh, sigmoid): the model check names
+/// `--sign dahl` where it lowers them (friction that lags the reversals). δ = 0: not computed.
+struct DahlAlternative {
+  double presliding = 0.0;  ///< δ of the best Dahl fit [rad]
+  double rss = 0.0, peak = 0.0;
+  double sign_rss = 0.0, sign_peak = 0.0;
+};
+
 /// The fitted friction of one joint and its fit statistics.
 struct JointFrictionFit {
   /// smoothing: v_s [rad/s], or the Dahl sign's δ [rad].
@@ -34,6 +44,7 @@ struct JointFrictionFit {
   double condition = 1.0;
   std::vector<double> residual;  ///< r(θ) over the whole log
   std::vector<std::string> warnings;
+  DahlAlternative dahl;
 };
 
 /// The least-squares line y ≈ intercept + slope x over the samples with use[k] != 0 (centred

@@ -19,6 +19,9 @@ constexpr double kOffsetSpreads = 2.0;
 // lower gains: a smaller share is noise that enters after that filter, through K B(q) δq̇.
 constexpr double kSuggestedCutoff = 20.0;  // [Hz]
 constexpr double kHighFrequencyLeft = 0.3;
+// Friction that lags the reversals: named when the Dahl sign lowers the friction fit's residual
+// sum of squares by this share (the real Panda's wrist: 29-44 %; a tanh friction's: none).
+constexpr double kMinDahlGain = 0.2;
 
 /// y ≈ c + a x1 + b x2 by least squares over the used samples: b, and the share of y's variance
 /// that x2 explains beyond x1 (R² of both minus R² of x1 alone).
@@ -117,6 +120,19 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
                                     ": the residual flips with sign(dq) (" +
                                     num(std::abs(coulomb.slope)) + " N m, R^2 " + num(coulomb.r2) +
                                     "): Coulomb friction the model lacks (calibrated)"});
+    }
+    // Lags the reversals: the same friction with the Dahl sign fits better (fit_joint).
+    const DahlAlternative& dahl = after[i].dahl;
+    if (dahl.presliding > 0.0 && count > 0 && dahl.rss <= (1.0 - kMinDahlGain) * dahl.sign_rss) {
+      check.patterns.push_back(
+          {"presliding", joint, 1.0 - dahl.rss / dahl.sign_rss,
+           "joint " + std::to_string(joint) +
+               ": the friction lags the velocity's reversals (a presliding displacement of ~" +
+               num(1e3 * dahl.presliding) + " mrad): --sign dahl lowers the friction fit's " +
+               "residual RMS from " + num(std::sqrt(dahl.sign_rss / count)) + " to " +
+               num(std::sqrt(dahl.rss / count)) + " N m and its largest value from " +
+               num(dahl.sign_peak) + " to " + num(dahl.peak) +
+               " N m (docs/calibration.md, the Dahl sign)"});
     }
     // Follows g(q): the calibrated residual against the filtered gravity torque.
     filter_regressor(s.gravity, s.alpha, z, s.filter_weight);

@@ -169,6 +169,14 @@ TEST(Calibration, DahlFrictionIsIdentifiedWhereAVelocitySignCannotFollowIt) {
     EXPECT_NE(what.find("does not look contact-free"), std::string::npos) << what;
     EXPECT_NE(what.find("--sign dahl"), std::string::npos) << what;
   }
+  // δ fixed (calibrate --presliding-displacement) at the truth's: kept on every joint, the same
+  // friction as where the grid chose it. (A δ off by a sixth, 3.5 mrad, leaves reversal peaks
+  // that the suspect-window test refuses as contacts on this noise-free log.)
+  CalibrationOptions fixed = dahl;
+  fixed.smoothing_velocity = 0.003;
+  const Calibration cal_fixed = calibrate(model, no_sensor(), log, fixed);
+  EXPECT_EQ(cal_fixed.friction.presliding, VectorX::Constant(7, 0.003));
+  EXPECT_EQ(cal_fixed.friction.coulomb, cal.friction.coulomb);
   // The observer with the fitted Dahl friction (its own state, from the positions) leaves the
   // residual the fit reports.
   const VectorX rms = observer_rms_after_settling(model, cal, log);

@@ -221,6 +221,20 @@ TEST(CalibrationPanda, DahlFrictionLowersTheWristThresholds) {
     EXPECT_LT(rep.min_force_calibrated[l], rep.min_force_constant[l]) << "link " << l;
     EXPECT_LT(rep.min_force_calibrated[l], rep_tanh.min_force_calibrated[l]) << "link " << l;
   }
+  // The tanh calibration's model check names the lag on the joints where the Dahl sign then
+  // lowers the held-out residual (5 and 7) and on no joint whose residual is noise (1-4); the
+  // Dahl calibration has nothing left to name.
+  std::vector<int> presliding;
+  for (const ModelPattern& p : tanh.model_check.patterns) {
+    if (p.kind != "presliding") continue;
+    std::printf("%s\n", p.message.c_str());
+    presliding.push_back(p.joint);
+    EXPECT_NE(p.message.find("--sign dahl"), std::string::npos);
+  }
+  EXPECT_NE(std::find(presliding.begin(), presliding.end(), 5), presliding.end());
+  EXPECT_NE(std::find(presliding.begin(), presliding.end(), 7), presliding.end());
+  for (const int j : presliding) EXPECT_GE(j, 5);
+  for (const ModelPattern& p : cal.model_check.patterns) EXPECT_NE(p.kind, "presliding");
 }
 
 // The inertia correction (--inertia) with the residual filter on joints 1-4: the fit finds the

@@ -135,6 +135,24 @@ TEST_F(Cli, UnknownCommandsAndOptionsAreUsageErrors) {
   EXPECT_TRUE(contains(r.err, "--no-such-option"));
 }
 
+// Each Coulomb sign has its own fixed scale: v_s for a sign of q̇, δ for the Dahl sign. The other
+// one is a usage error that names the option (before any file is read).
+TEST_F(Cli, CalibrateRefusesTheOtherSignsScale) {
+  const std::string files = "calibrate --config none.yaml --log none.csv --out calib.yaml ";
+  const RunResult dahl_vs = run(files + "--sign dahl --smoothing-velocity 0.01");
+  EXPECT_EQ(dahl_vs.code, kExitUsageError);
+  EXPECT_TRUE(contains(dahl_vs.err, "--smoothing-velocity: not used with --sign dahl"));
+  EXPECT_TRUE(contains(dahl_vs.err, "--presliding-displacement"));
+  for (const char* sign : {"tanh", "sigmoid"}) {
+    const RunResult r = run(files + "--sign " + sign + " --presliding-displacement 0.003");
+    EXPECT_EQ(r.code, kExitUsageError) << sign;
+    EXPECT_TRUE(contains(r.err, "--presliding-displacement: only with --sign dahl")) << sign;
+  }
+  const RunResult negative = run(files + "--sign dahl --presliding-displacement -0.003");
+  EXPECT_EQ(negative.code, kExitUsageError);
+  EXPECT_TRUE(contains(negative.err, "--presliding-displacement"));
+}
+
 // ---- info --------------------------------------------------------------------------------
 
 /// Link names and masses read from the URDF text by the test (independent of our parser).
