@@ -27,17 +27,36 @@ constexpr NumberRules kScenarioNumber{.infinity = true};
 
 void parse_trajectory(const YamlReader& y, const YAML::Node& node, int n,
                       sim::SinusoidalTrajectory& tr) {
-  y.only_keys(node, "trajectory", {"offset", "amplitude", "frequency", "phase"});
-  const auto part = [&](const char* k) {
-    return node[k] ? y.vector(node[k], YamlReader::key("trajectory", k), n) : VectorX::Zero(n);
+  y.only_keys(node, "trajectory", {"offset", "amplitude", "frequency", "phase", "more_sines"});
+  // One sine's amplitude, frequency and phase under `where` (n numbers or one for all).
+  const auto sine = [&](const YAML::Node& m, const std::string& where, VectorX& amplitude,
+                        VectorX& frequency, VectorX& phase) {
+    const auto part = [&](const char* k) {
+      return m[k] ? y.vector(m[k], YamlReader::key(where, k), n) : VectorX::Zero(n);
+    };
+    amplitude = part("amplitude");
+    frequency = part("frequency");
+    phase = part("phase");
+    for (int i = 0; i < n; ++i) {
+      if (frequency[i] < 0.0)
+        y.fail(m["frequency"], where + ".frequency", "frequencies must be >= 0 [Hz]");
+    }
   };
-  tr.offset = part("offset");
-  tr.amplitude = part("amplitude");
-  tr.frequency = part("frequency");
-  tr.phase = part("phase");
-  for (int i = 0; i < n; ++i) {
-    if (tr.frequency[i] < 0.0)
-      y.fail(node["frequency"], "trajectory.frequency", "frequencies must be >= 0 [Hz]");
+  tr.offset = node["offset"] ? y.vector(node["offset"], "trajectory.offset", n) : VectorX::Zero(n);
+  sine(node, "trajectory", tr.amplitude, tr.frequency, tr.phase);
+  tr.more_sines.clear();
+  if (const YAML::Node more = node["more_sines"]) {
+    if (!more.IsSequence()) {
+      y.fail(more, "trajectory.more_sines",
+             "expected a list of sines ({amplitude, frequency, phase} each)");
+    }
+    for (std::size_t k = 0; k < more.size(); ++k) {
+      const std::string where = "trajectory.more_sines[" + std::to_string(k) + "]";
+      y.only_keys(more[k], where, {"amplitude", "frequency", "phase"});
+      sim::SineTerm term;
+      sine(more[k], where, term.amplitude, term.frequency, term.phase);
+      tr.more_sines.push_back(std::move(term));
+    }
   }
 }
 

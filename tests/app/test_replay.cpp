@@ -7,12 +7,14 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <numbers>
 #include <sstream>
 
 #include "extwrench/app/scenario_run.hpp"
@@ -275,6 +277,19 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        ":4: trajectory.offset: expected 7 values (or one for all), got 2"},
       {"trajectory_key", replace(kGoodScenario, "phase: 0", "phase: 0, speed: 1"),
        "trajectory.speed: unknown key"},
+      {"more_sines_not_a_list",
+       replace(kGoodScenario, "phase: 0}", "phase: 0, more_sines: {amplitude: 0.1}}"),
+       ":4: trajectory.more_sines: expected a list of sines"},
+      {"more_sines_size",
+       replace(kGoodScenario, "phase: 0}",
+               "phase: 0, more_sines: [{amplitude: 0.1, frequency: 1}, {amplitude: [1, 2]}]}"),
+       ":4: trajectory.more_sines[1].amplitude: expected 7 values (or one for all), got 2"},
+      {"more_sines_key",
+       replace(kGoodScenario, "phase: 0}", "phase: 0, more_sines: [{offset: 0.1}]}"),
+       "trajectory.more_sines[0].offset: unknown key"},
+      {"more_sines_frequency",
+       replace(kGoodScenario, "phase: 0}", "phase: 0, more_sines: [{frequency: -1}]}"),
+       "trajectory.more_sines[0].frequency: frequencies must be >= 0 [Hz]"},
       {"bad_number", replace(kGoodScenario, "duration: 0.5", "duration: fast"),
        ":3: duration: expected a finite number, got 'fast'"},
       {"negative_duration", replace(kGoodScenario, "duration: 0.5", "duration: -1"),
@@ -321,6 +336,36 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
     const std::string what = error_of([&] { (void)load_scenario(path); });
     EXPECT_NE(what.find(c.expected), std::string::npos) << c.name << ": " << what;
     EXPECT_NE(what.find(path.filename().string()), std::string::npos) << c.name << ": " << what;
+  }
+}
+
+// Several sines per joint (an identification motion): each term read as the first sine is, and
+// the trajectory their sum, its q̇ and q̈ the derivatives of its q (central differences).
+TEST_F(Replay, ScenarioTrajectorySumsMoreSines) {
+  const fs::path dir = temp_dir("moresines");
+  write_text(dir / "s.yaml",
+             replace(kGoodScenario, "phase: 0}",
+                     "phase: 0, more_sines: [{amplitude: 0.1, frequency: [1.1, 1.2, 1.3, 1.4, "
+                     "1.5, 1.6, 1.7], phase: 0.5}, {amplitude: 0.05, frequency: 2.9}]}"));
+  const Scenario scenario = load_scenario(dir / "s.yaml");
+  const sim::SinusoidalTrajectory& tr = scenario.trajectory;
+  ASSERT_EQ(tr.size(), 7);
+  ASSERT_EQ(tr.more_sines.size(), 2U);
+  EXPECT_EQ(tr.more_sines[0].frequency[6], 1.7);
+  EXPECT_EQ(tr.more_sines[1].phase, VectorX::Zero(7));
+  VectorX q(7), dq(7), ddq(7), q_lo(7), q_hi(7), dq_lo(7), dq_hi(7), unused(7);
+  const double t = 0.37, h = 1e-5;
+  tr.evaluate(t, q, dq, ddq);
+  tr.evaluate(t - h, q_lo, dq_lo, unused);
+  tr.evaluate(t + h, q_hi, dq_hi, unused);
+  for (int i = 0; i < 7; ++i) {
+    const double two_pi_t = 2.0 * std::numbers::pi * t;
+    const double expected = 0.3 + 0.2 * std::sin(0.5 * two_pi_t) +
+                            0.1 * std::sin((1.1 + 0.1 * i) * two_pi_t + 0.5) +
+                            0.05 * std::sin(2.9 * two_pi_t);
+    EXPECT_NEAR(q[i], expected, 1e-12) << i;
+    EXPECT_NEAR(dq[i], (q_hi[i] - q_lo[i]) / (2 * h), 1e-7) << i;
+    EXPECT_NEAR(ddq[i], (dq_hi[i] - dq_lo[i]) / (2 * h), 1e-6) << i;
   }
 }
 

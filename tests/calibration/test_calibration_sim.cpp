@@ -449,6 +449,53 @@ TEST(ModelCheckSim, NamesARotorInertiaTheModelLacks) {
   }
 }
 
+// The same rotors, and one on joint 2 too, in a motion of two sines per joint (an identification
+// motion, trajectory.more_sines): q̈ no longer follows q, so each rotor is named `inertia`, not
+// `inertia_or_gravity` (nor missed, as joint 2's would be with one sine), and --inertia corrects
+// all three.
+TEST(ModelCheckSim, TwoFrequenciesPerJointTellEachRotorFromAGravityError) {
+  const Model model = paper_arm();
+  Model with_rotors = model;
+  with_rotors.joints[1].armature = 0.4;
+  with_rotors.joints[2].armature = 0.2;
+  with_rotors.joints[4].armature = 0.3;
+  sim::SinusoidalTrajectory motion = test::free_motion(0.0, 1.0);
+  sim::SineTerm second;
+  second.amplitude = 0.4 * motion.amplitude;
+  second.frequency = VectorX{{0.37, 0.41, 0.47, 0.53, 0.59, 0.61, 0.67}};
+  second.phase = VectorX::Constant(7, 0.3);
+  motion.more_sines.push_back(second);
+  const auto log = test::simulate_free_motion(with_rotors, motion, test::paper_arm_friction(), 20.0,
+                                              Vector6::Zero(), kTauNoise, 59);
+  CalibrationOptions with_inertia;
+  with_inertia.inertia_correction = true;
+  const Calibration uncorrected = calibrate(model, ft_options(), log);
+  const Calibration cal = calibrate(model, ft_options(), log, with_inertia);
+  const double truth[8] = {0, 0.4, 0.2, 0, 0.3, 0, 0, 0};
+  for (const Calibration* c : {&uncorrected, &cal}) {
+    (void)kinds(*c);
+    std::vector<int> named;
+    for (const ModelPattern& p : c->model_check.patterns) {
+      EXPECT_NE(p.kind, "inertia_or_gravity") << p.message;
+      if (p.kind != "inertia") continue;
+      named.push_back(p.joint);
+      const std::string size = p.message.substr(p.message.find("along it is ") + 12);
+      EXPECT_NEAR(std::stod(size), truth[p.joint], 0.2 * truth[p.joint]) << p.message;
+    }
+    EXPECT_EQ(named, (std::vector<int>{1, 2, 4}));
+  }
+  for (const std::string& w : cal.warnings) EXPECT_EQ(w.find("is not applied"), std::string::npos);
+  ASSERT_EQ(cal.inertia_correction.size(), 7);
+  for (int i = 0; i < 7; ++i) {
+    std::printf("joint %d: dI %.4f (true %.1f), residual RMS %.4f -> %.4f N m\n", i + 1,
+                cal.inertia_correction[i], truth[i + 1],
+                uncorrected.joints[static_cast<std::size_t>(i)].rms_after,
+                cal.joints[static_cast<std::size_t>(i)].rms_after);
+    EXPECT_NEAR(cal.inertia_correction[i], truth[i + 1], 0.05 * std::max(truth[i + 1], 0.1))
+        << "joint " << i + 1;
+  }
+}
+
 TEST(ModelCheckSim, NamesASensorOrientationError) {
   const Model model = paper_arm();
   Pose tilted;
