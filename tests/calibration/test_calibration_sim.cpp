@@ -387,6 +387,23 @@ TEST(ModelCheckSim, NamesAMassErrorThroughGravityAndTheBaseForce) {
   for (int i = 1; i < 4; ++i) EXPECT_EQ(corrected.inertia_correction[i], 0.0) << "joint " << i + 1;
 }
 
+// The correction `cal` applied per joint against `expected` (1-based, within `tolerance` of
+// max(expected, 0.1)), printed beside the true rotor and the residual RMS without it.
+void expect_inertia_correction(const Calibration& uncorrected, const Calibration& cal,
+                               const double (&truth)[8], const double (&expected)[8],
+                               double tolerance) {
+  ASSERT_EQ(cal.inertia_correction.size(), 7);
+  for (int i = 0; i < 7; ++i) {
+    std::printf("joint %d: dI %.4f (true %.1f), residual RMS %.4f -> %.4f N m\n", i + 1,
+                cal.inertia_correction[i], truth[i + 1],
+                uncorrected.joints[static_cast<std::size_t>(i)].rms_after,
+                cal.joints[static_cast<std::size_t>(i)].rms_after);
+    EXPECT_NEAR(cal.inertia_correction[i], expected[i + 1],
+                tolerance * std::max(expected[i + 1], 0.1))
+        << "joint " << i + 1;
+  }
+}
+
 // A rotor inertia (armature) on joints 1 and 4 that the model lacks: the residual follows their
 // acceleration, −δI q̈. In this motion (one sine per joint) q̈_i = −ω² (q_i − q0) follows q_i, and
 // so would a gravity error that changes with q_i (a centre of mass off): joint 1's axis is
@@ -433,15 +450,7 @@ TEST(ModelCheckSim, NamesARotorInertiaTheModelLacks) {
                     w.find("several frequencies") != std::string::npos);
   EXPECT_TRUE(said);
   const double applied[8] = {0, 0.4, 0, 0, 0, 0, 0, 0};
-  ASSERT_EQ(cal.inertia_correction.size(), 7);
-  for (int i = 0; i < 7; ++i) {
-    std::printf("joint %d: dI %.4f (true %.1f), residual RMS %.4f -> %.4f N m\n", i + 1,
-                cal.inertia_correction[i], truth[i + 1],
-                uncorrected.joints[static_cast<std::size_t>(i)].rms_after,
-                cal.joints[static_cast<std::size_t>(i)].rms_after);
-    EXPECT_NEAR(cal.inertia_correction[i], applied[i + 1], 0.02 * std::max(applied[i + 1], 0.1))
-        << "joint " << i + 1;
-  }
+  expect_inertia_correction(uncorrected, cal, truth, applied, 0.02);
   // Joint 1's rotor torque leaves the residual: what is left is the torque noise's level.
   for (const int i : {0}) {
     EXPECT_LT(cal.joints[static_cast<std::size_t>(i)].rms_after,
@@ -485,15 +494,7 @@ TEST(ModelCheckSim, TwoFrequenciesPerJointTellEachRotorFromAGravityError) {
     EXPECT_EQ(named, (std::vector<int>{1, 2, 4}));
   }
   for (const std::string& w : cal.warnings) EXPECT_EQ(w.find("is not applied"), std::string::npos);
-  ASSERT_EQ(cal.inertia_correction.size(), 7);
-  for (int i = 0; i < 7; ++i) {
-    std::printf("joint %d: dI %.4f (true %.1f), residual RMS %.4f -> %.4f N m\n", i + 1,
-                cal.inertia_correction[i], truth[i + 1],
-                uncorrected.joints[static_cast<std::size_t>(i)].rms_after,
-                cal.joints[static_cast<std::size_t>(i)].rms_after);
-    EXPECT_NEAR(cal.inertia_correction[i], truth[i + 1], 0.05 * std::max(truth[i + 1], 0.1))
-        << "joint " << i + 1;
-  }
+  expect_inertia_correction(uncorrected, cal, truth, truth, 0.05);
 }
 
 TEST(ModelCheckSim, NamesASensorOrientationError) {
