@@ -113,13 +113,38 @@ void parse_encoder(const YamlReader& y, const YAML::Node& e, sim::EncoderModel& 
   y.set_number_in(e, "sensors.encoder", "velocity_cutoff", non_negative(), encoder.velocity_cutoff);
 }
 
+// sensors.joint_torque: {friction: {viscous, coulomb, smoothing_velocity}, offset, noise}.
+void parse_joint_torque(const YamlReader& y, const YAML::Node& j, const Scenario& s,
+                        sim::JointTorqueModel& torque) {
+  const std::string k = "sensors.joint_torque";
+  y.only_keys(j, k, {"friction", "offset", "noise"});
+  if (s.engine == Scenario::Engine::kMujoco) {
+    y.fail(j, k,
+           "with the rigid engine only (MuJoCo's joint friction is the MJCF's frictionloss and "
+           "damping)");
+  }
+  const int n = s.robot.model.nq();
+  const Range at_least_zero = non_negative();
+  if (const YAML::Node f = j["friction"]) {
+    const std::string kf = k + ".friction";
+    y.only_keys(f, kf, {"viscous", "coulomb", "smoothing_velocity"});
+    if (f["viscous"]) torque.viscous = y.vector(f["viscous"], kf + ".viscous", n, &at_least_zero);
+    if (f["coulomb"]) torque.coulomb = y.vector(f["coulomb"], kf + ".coulomb", n, &at_least_zero);
+    y.set_number_in(f, kf, "smoothing_velocity", positive(), torque.smoothing_velocity);
+  }
+  if (j["offset"]) torque.offset = y.vector(j["offset"], k + ".offset", n);
+  y.set_number_in(j, k, "noise", non_negative(), torque.noise);
+}
+
 void parse_sensors(const YamlReader& y, const YAML::Node& node, Scenario& s) {
-  y.only_keys(node, "sensors", {"base", "encoder", "log_velocity"});
+  y.only_keys(node, "sensors", {"base", "encoder", "joint_torque", "log_velocity"});
   sim::BaseSensorModel& base = s.simulation.sensor;
   base.type = SensorType::kForceTorque;
   base.X_WS = default_sensor_pose(s.robot.model);  // a "sensor" frame on a moving body: identity
   if (const YAML::Node b = node["base"]) parse_base_sensor(y, b, base);
   if (const YAML::Node e = node["encoder"]) parse_encoder(y, e, s.simulation.encoder);
+  if (const YAML::Node j = node["joint_torque"])
+    parse_joint_torque(y, j, s, s.simulation.joint_torque);
   if (node["log_velocity"])
     s.log_velocity = y.boolean(node["log_velocity"], "sensors.log_velocity");
 }

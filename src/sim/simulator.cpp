@@ -9,6 +9,10 @@
 #include "extwrench/dynamics/rnea.hpp"
 
 namespace extwrench::sim {
+namespace {
+// Offset of the joint torques' noise seed from the base sensor's (docs/simulation.md).
+constexpr std::uint64_t kTorqueNoiseStream = 0x746f7271;  // "torq"
+}  // namespace
 
 Rk4Workspace::Rk4Workspace(const Model& model) : data(model), jacobian(6, model.nq()) {
   const int n = model.nq();
@@ -62,8 +66,10 @@ Simulator::Simulator(const Model& model, ComputedTorqueController controller,
       config_(std::move(config)),
       ws_(model_),
       joint_sensor_(config_.encoder, model_.nq()),
-      noise_(config_.noise_seed) {
+      noise_(config_.noise_seed),
+      torque_noise_(config_.noise_seed + kTorqueNoiseStream) {
   const int n = model_.nq();
+  config_.joint_torque.validate(n, "simulator: joint_torque");
   if (controller_.model().nq() != n) {
     throw Error("simulator: the controller's model has " +
                 std::to_string(controller_.model().nq()) + " joints, the robot " +
@@ -109,6 +115,7 @@ bool Simulator::next(Sample& out) {
   out.q = qm_;
   out.dq = dqm_;
   out.tau = tau;
+  if (config_.joint_torque.active()) config_.joint_torque.add_to(dq_, torque_noise_, out.tau);
   // The truth at t_k: true acceleration under τ_k, then one RNEA pass with the external
   // wrenches down to link 0 for the base reading (eqs. 9–10).
   if (!true_acceleration(model_, config_.forces, t, q_, dq_, tau, ws_)) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/crba.hpp"
@@ -256,6 +257,72 @@ TEST(Controller, ComputedTorqueWithTheExactModelTracksTheTrajectory) {
   EXPECT_EQ(sim.num_samples(), 1001);
   EXPECT_NEAR(first_error, 0.05, 1e-12);
   EXPECT_LT(last_error, 1e-4);
+}
+
+// The logged joint torques carry the friction the drives overcome, offsets and noise
+// (JointTorqueModel); the motion, the truth and the base sensor's noise stream stay exactly those
+// of the run without them, and the logged τ minus the command is D q̇ + F_c tanh(q̇ / v_s) + o of
+// the true q̇ (with exact encoders, the logged one) plus noise of the configured spread.
+TEST(Simulator, JointTorqueModelAddsFrictionOffsetsAndNoiseToTheLogOnly) {
+  const int n = 4;
+  const Model model = random_chain({.n = n, .seed = 42});
+  SimulationConfig plain;
+  plain.duration = 2.0;
+  plain.sensor.force_noise_S = Vector3::Constant(0.1);
+  plain.noise_seed = 7;
+  SimulationConfig with = plain;
+  JointTorqueModel& jt = with.joint_torque;
+  jt.viscous = VectorX::LinSpaced(n, 0.2, 0.5);
+  jt.coulomb = VectorX::LinSpaced(n, 0.3, 0.9);
+  jt.smoothing_velocity = 0.05;
+  jt.offset = VectorX::LinSpaced(n, -0.1, 0.2);
+  const auto gains = pid_gains_triple_pole(n, 20.0);
+  Simulator a(model, ComputedTorqueController(model, small_sinusoid(n), gains), plain);
+  Simulator b(model, ComputedTorqueController(model, small_sinusoid(n), gains), with);
+  Sample sa, sb;
+  while (a.next(sa)) {
+    ASSERT_TRUE(b.next(sb));
+    ASSERT_EQ(sa.q, sb.q);
+    ASSERT_EQ(sa.reading_S, sb.reading_S);
+    for (int i = 0; i < n; ++i) {
+      const double friction = jt.viscous[i] * sa.dq[i] +
+                              jt.coulomb[i] * std::tanh(sa.dq[i] / jt.smoothing_velocity) +
+                              jt.offset[i];
+      ASSERT_NEAR(sb.tau[i] - sa.tau[i], friction, 1e-12) << "joint " << i + 1 << " t " << sa.t;
+    }
+  }
+  // Noise only: zero mean, the configured spread, per joint.
+  SimulationConfig noisy = plain;
+  noisy.joint_torque.noise = 0.05;
+  Simulator c(model, ComputedTorqueController(model, small_sinusoid(n), gains), plain);
+  Simulator d(model, ComputedTorqueController(model, small_sinusoid(n), gains), noisy);
+  VectorX sum = VectorX::Zero(n), sum2 = VectorX::Zero(n);
+  double count = 0;
+  while (c.next(sa)) {
+    ASSERT_TRUE(d.next(sb));
+    const VectorX e = sb.tau - sa.tau;
+    sum += e;
+    sum2 += e.cwiseProduct(e);
+    count += 1;
+  }
+  for (int i = 0; i < n; ++i) {
+    const double mean = sum[i] / count, sd = std::sqrt(sum2[i] / count - mean * mean);
+    EXPECT_NEAR(mean, 0.0, 5 * 0.05 / std::sqrt(count));
+    EXPECT_NEAR(sd, 0.05, 5 * 0.05 / std::sqrt(2 * count));
+  }
+  // Bad coefficients name what is wrong.
+  SimulationConfig bad = plain;
+  bad.joint_torque.viscous = VectorX::Constant(n + 1, 0.1);
+  EXPECT_THROW(Simulator(model, ComputedTorqueController(model, small_sinusoid(n), gains), bad),
+               Error);
+  bad = plain;
+  bad.joint_torque.coulomb = VectorX::Constant(n, -0.1);
+  try {
+    Simulator s(model, ComputedTorqueController(model, small_sinusoid(n), gains), bad);
+    FAIL() << "a negative Coulomb friction was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("joint_torque.coulomb[0]"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Controller, IntegralTermRecoversThePathUnderAConstantForce) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "extwrench/core/sample.hpp"
 #include "extwrench/core/types.hpp"
@@ -36,6 +37,27 @@ struct EncoderModel {
 
   /// Quantized position: resolution · round(q / resolution).
   [[nodiscard]] double quantize(double q) const noexcept;
+};
+
+/// The joint torques the robot logs beside the command τ that the link dynamics see: the
+/// friction its drives overcome, τ_f = D q̇ + F_c tanh(q̇ / v_s) of the true q̇ (a drive that
+/// delivers it on top of the command, as a joint-torque or current measurement then contains
+/// it), a constant offset per joint and white Gaussian noise: τ_log = τ + τ_f + o + σ n.
+/// Empty vectors: none. What a calibration identifies (docs/calibration.md).
+struct JointTorqueModel {
+  VectorX viscous;                   ///< D_i [N m s/rad] (n, or empty)
+  VectorX coulomb;                   ///< F_c,i [N m] (n, or empty)
+  double smoothing_velocity = 0.03;  ///< v_s [rad/s] > 0
+  VectorX offset;                    ///< o_i [N m] (n, or empty)
+  double noise = 0.0;                ///< σ [N m] ≥ 0, every joint
+
+  /// Any term set.
+  [[nodiscard]] bool active() const noexcept;
+  /// Throws extwrench::Error naming `where` on sizes other than n (or empty), negative or
+  /// non-finite coefficients, v_s ≤ 0, σ < 0.
+  void validate(int n, const std::string& where) const;
+  /// τ (the command, n) += τ_f(dq) + o + σ n, the noise drawn for every joint from `rng`.
+  void add_to(const VectorX& dq, Rng& rng, VectorX& tau) const noexcept;
 };
 
 /// Measured joint state from the true one, sample after sample.

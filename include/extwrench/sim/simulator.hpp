@@ -19,7 +19,8 @@ struct SimulationConfig {
   std::vector<ForceProfile> forces;
   BaseSensorModel sensor;
   EncoderModel encoder;
-  std::uint64_t noise_seed = 1;  ///< seed of the sensor noise stream
+  JointTorqueModel joint_torque;  ///< what the logged τ carries beyond the command (none)
+  std::uint64_t noise_seed = 1;   ///< seed of the sensor noise streams
   /// Initial state; empty: the desired trajectory's q_d(0), q̇_d(0).
   VectorX q0, dq0;
 };
@@ -71,6 +72,7 @@ class Simulator final : public SampleSource {
   Rk4Workspace ws_;
   JointSensor joint_sensor_;
   Rng noise_;
+  Rng torque_noise_;  ///< the joint torques' own stream: the base sensor's stays as without it
   VectorX q_, dq_, qm_, dqm_;
   long k_ = 0;
   long num_samples_ = 0;
