@@ -13,22 +13,33 @@ int SinusoidalTrajectory::size() const {
   return static_cast<int>(n);
 }
 
+namespace {
+
+// a sin(2π f t + φ) and its first two time derivatives.
+struct SineValue {
+  double q, dq, ddq;
+};
+SineValue sine_at(double amplitude, double frequency, double phase, double t) noexcept {
+  const double w = 2.0 * std::numbers::pi * frequency;
+  const double s = std::sin(w * t + phase);
+  const double c = std::cos(w * t + phase);
+  return {amplitude * s, amplitude * w * c, -amplitude * w * w * s};
+}
+
+}  // namespace
+
 void SinusoidalTrajectory::evaluate(double t, Eigen::Ref<VectorX> q, Eigen::Ref<VectorX> dq,
                                     Eigen::Ref<VectorX> ddq) const noexcept {
   for (Eigen::Index i = 0; i < offset.size(); ++i) {
-    const double w = 2.0 * std::numbers::pi * frequency[i];
-    const double s = std::sin(w * t + phase[i]);
-    const double c = std::cos(w * t + phase[i]);
-    q[i] = offset[i] + amplitude[i] * s;
-    dq[i] = amplitude[i] * w * c;
-    ddq[i] = -amplitude[i] * w * w * s;
+    const SineValue first = sine_at(amplitude[i], frequency[i], phase[i], t);
+    q[i] = offset[i] + first.q;
+    dq[i] = first.dq;
+    ddq[i] = first.ddq;
     for (const SineTerm& term : more_sines) {
-      const double wk = 2.0 * std::numbers::pi * term.frequency[i];
-      const double sk = std::sin(wk * t + term.phase[i]);
-      const double ck = std::cos(wk * t + term.phase[i]);
-      q[i] += term.amplitude[i] * sk;
-      dq[i] += term.amplitude[i] * wk * ck;
-      ddq[i] -= term.amplitude[i] * wk * wk * sk;
+      const SineValue more = sine_at(term.amplitude[i], term.frequency[i], term.phase[i], t);
+      q[i] += more.q;
+      dq[i] += more.dq;
+      ddq[i] += more.ddq;
     }
   }
 }
