@@ -9,6 +9,7 @@
 #include <numbers>
 #include <string>
 
+#include "detail/friction_yaml.hpp"
 #include "detail/yaml_reader.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/number_text.hpp"
@@ -113,26 +114,18 @@ void parse_encoder(const YamlReader& y, const YAML::Node& e, sim::EncoderModel& 
   y.set_number_in(e, "sensors.encoder", "velocity_cutoff", non_negative(), encoder.velocity_cutoff);
 }
 
-// sensors.joint_torque: {friction: {viscous, coulomb, smoothing_velocity}, offset, noise}.
+// sensors.joint_torque: {friction: the configuration's friction mapping, noise}.
 void parse_joint_torque(const YamlReader& y, const YAML::Node& j, const Scenario& s,
                         sim::JointTorqueModel& torque) {
   const std::string k = "sensors.joint_torque";
-  y.only_keys(j, k, {"friction", "offset", "noise"});
+  y.only_keys(j, k, {"friction", "noise"});
   if (s.engine == Scenario::Engine::kMujoco) {
     y.fail(j, k,
            "with the rigid engine only (MuJoCo's joint friction is the MJCF's frictionloss and "
            "damping)");
   }
-  const int n = s.robot.model.nq();
-  const Range at_least_zero = non_negative();
-  if (const YAML::Node f = j["friction"]) {
-    const std::string kf = k + ".friction";
-    y.only_keys(f, kf, {"viscous", "coulomb", "smoothing_velocity"});
-    if (f["viscous"]) torque.viscous = y.vector(f["viscous"], kf + ".viscous", n, &at_least_zero);
-    if (f["coulomb"]) torque.coulomb = y.vector(f["coulomb"], kf + ".coulomb", n, &at_least_zero);
-    y.set_number_in(f, kf, "smoothing_velocity", positive(), torque.smoothing_velocity);
-  }
-  if (j["offset"]) torque.offset = y.vector(j["offset"], k + ".offset", n);
+  if (const YAML::Node f = j["friction"])
+    torque.friction = io_detail::read_friction_mapping(y, f, s.robot.model.nq(), k + ".friction");
   y.set_number_in(j, k, "noise", non_negative(), torque.noise);
 }
 

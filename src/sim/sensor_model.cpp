@@ -53,39 +53,10 @@ void JointSensor::measure(double t, const VectorX& q, const VectorX& dq, VectorX
   last_dq_ = dq_out;
 }
 
-bool JointTorqueModel::active() const noexcept {
-  return viscous.size() > 0 || coulomb.size() > 0 || offset.size() > 0 || noise > 0.0;
-}
-
 void JointTorqueModel::validate(int n, const std::string& where) const {
-  const auto check = [&](const VectorX& v, const char* name, bool non_negative) {
-    if (v.size() != 0 && v.size() != n) {
-      throw Error(where + "." + name + ": expected " + std::to_string(n) + " values, got " +
-                  std::to_string(v.size()));
-    }
-    for (Eigen::Index i = 0; i < v.size(); ++i) {
-      if (!std::isfinite(v[i]) || (non_negative && v[i] < 0.0)) {
-        throw Error(where + "." + name + "[" + std::to_string(i) + "]: expected a finite value" +
-                    (non_negative ? " >= 0" : "") + ", got " + std::to_string(v[i]));
-      }
-    }
-  };
-  check(viscous, "viscous", true);
-  check(coulomb, "coulomb", true);
-  check(offset, "offset", false);
-  if (!(smoothing_velocity > 0.0) || !std::isfinite(smoothing_velocity))
-    throw Error(where + ".smoothing_velocity: expected a finite value > 0");
+  if (friction) validate_friction(*friction, n, where);
   if (!(noise >= 0.0) || !std::isfinite(noise))
     throw Error(where + ".noise: expected a finite value >= 0");
-}
-
-void JointTorqueModel::add_to(const VectorX& dq, Rng& rng, VectorX& tau) const noexcept {
-  for (Eigen::Index i = 0; i < tau.size(); ++i) {
-    if (viscous.size() > 0) tau[i] += viscous[i] * dq[i];
-    if (coulomb.size() > 0) tau[i] += coulomb[i] * std::tanh(dq[i] / smoothing_velocity);
-    if (offset.size() > 0) tau[i] += offset[i];
-    if (noise > 0.0) tau[i] += noise * rng.normal();
-  }
 }
 
 }  // namespace extwrench::sim

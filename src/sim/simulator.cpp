@@ -99,9 +99,31 @@ Simulator::Simulator(const Model& model, ComputedTorqueController controller,
   }
   qm_.setZero(n);
   dqm_.setZero(n);
+  tau_friction_.setZero(n);
+  presliding_state_.setZero(n);  // at rest the presliding state is unknown, as the observer's
+  presliding_q_ = q_;
   // Samples at k·Ts for k·Ts <= duration (a tiny tolerance absorbs the division's rounding).
   num_samples_ = static_cast<long>(std::floor(config_.duration / config_.sample_time + 1e-9)) + 1;
   controller_.reset(0.0);
+}
+
+// τ += τ_f of the true motion + σ n (config_.joint_torque), the Dahl state advanced by the true
+// Δq since the last sample as the observer advances its own.
+void Simulator::add_joint_torque_terms(VectorX& tau) noexcept {
+  const JointTorqueModel& jt = config_.joint_torque;
+  if (jt.friction) {
+    const JointFriction& f = *jt.friction;
+    if (f.sign == SmoothSign::kDahl) {
+      for (Eigen::Index i = 0; i < q_.size(); ++i)
+        presliding_state_[i] =
+            dahl_step(presliding_state_[i], q_[i] - presliding_q_[i], f.presliding[i]);
+      presliding_q_ = q_;
+    }
+    friction_torque(f, dq_, presliding_state_, tau_friction_);
+    tau += tau_friction_;
+  }
+  if (jt.noise > 0.0)
+    for (Eigen::Index i = 0; i < tau.size(); ++i) tau[i] += jt.noise * torque_noise_.normal();
 }
 
 bool Simulator::next(Sample& out) {
@@ -115,7 +137,7 @@ bool Simulator::next(Sample& out) {
   out.q = qm_;
   out.dq = dqm_;
   out.tau = tau;
-  if (config_.joint_torque.active()) config_.joint_torque.add_to(dq_, torque_noise_, out.tau);
+  if (config_.joint_torque.active()) add_joint_torque_terms(out.tau);
   // The truth at t_k: true acceleration under τ_k, then one RNEA pass with the external
   // wrenches down to link 0 for the base reading (eqs. 9–10).
   if (!true_acceleration(model_, config_.forces, t, q_, dq_, tau, ws_)) {

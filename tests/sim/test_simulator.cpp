@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "calibration/calibration_sim.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -271,7 +272,8 @@ TEST(Simulator, JointTorqueModelAddsFrictionOffsetsAndNoiseToTheLogOnly) {
   plain.sensor.force_noise_S = Vector3::Constant(0.1);
   plain.noise_seed = 7;
   SimulationConfig with = plain;
-  JointTorqueModel& jt = with.joint_torque;
+  JointFriction& jt = with.joint_torque.friction.emplace(JointFriction::none(n));
+  jt.sign = SmoothSign::kTanh;
   jt.viscous = VectorX::LinSpaced(n, 0.2, 0.5);
   jt.coulomb = VectorX::LinSpaced(n, 0.3, 0.9);
   jt.smoothing_velocity = 0.05;
@@ -290,6 +292,29 @@ TEST(Simulator, JointTorqueModelAddsFrictionOffsetsAndNoiseToTheLogOnly) {
                               jt.offset[i];
       ASSERT_NEAR(sb.tau[i] - sa.tau[i], friction, 1e-12) << "joint " << i + 1 << " t " << sa.t;
     }
+  }
+  // The Dahl sign: its state from zero, advanced by the true Δq (exact encoders: the logged q),
+  // against an explicit Euler integration of dz/dq = (sign(Δq) − z) / δ.
+  SimulationConfig dahl = plain;
+  JointFriction& jd = dahl.joint_torque.friction.emplace(jt);
+  jd.sign = SmoothSign::kDahl;
+  jd.presliding = VectorX::Constant(n, 0.003);
+  Simulator e(model, ComputedTorqueController(model, small_sinusoid(n), gains), plain);
+  Simulator g(model, ComputedTorqueController(model, small_sinusoid(n), gains), dahl);
+  VectorX z = VectorX::Zero(n), q_prev(n);
+  bool first = true;
+  while (e.next(sa)) {
+    ASSERT_TRUE(g.next(sb));
+    for (int i = 0; i < n; ++i) {
+      // 20 × 200 Euler steps a sample: their own error stays well below the tolerance.
+      for (int part = 0; part < 20 && !first; ++part)
+        z[i] = test::dahl_euler(z[i], (sa.q[i] - q_prev[i]) / 20.0, 0.003);
+      const double friction = jd.viscous[i] * sa.dq[i] + jd.coulomb[i] * z[i] + jd.offset[i];
+      // A sign of q̇ instead of the state would be F_c (0.3–0.9 N m) off after each reversal.
+      ASSERT_NEAR(sb.tau[i] - sa.tau[i], friction, 1e-4) << "joint " << i + 1 << " t " << sa.t;
+    }
+    q_prev = sa.q;
+    first = false;
   }
   // Noise only: zero mean, the configured spread, per joint.
   SimulationConfig noisy = plain;
@@ -312,16 +337,19 @@ TEST(Simulator, JointTorqueModelAddsFrictionOffsetsAndNoiseToTheLogOnly) {
   }
   // Bad coefficients name what is wrong.
   SimulationConfig bad = plain;
-  bad.joint_torque.viscous = VectorX::Constant(n + 1, 0.1);
+  bad.joint_torque.friction = JointFriction::none(n);
+  bad.joint_torque.friction->viscous = VectorX::Constant(n + 1, 0.1);
   EXPECT_THROW(Simulator(model, ComputedTorqueController(model, small_sinusoid(n), gains), bad),
                Error);
   bad = plain;
-  bad.joint_torque.coulomb = VectorX::Constant(n, -0.1);
+  bad.joint_torque.friction = JointFriction::none(n);
+  bad.joint_torque.friction->coulomb = VectorX::Constant(n, -0.1);
   try {
     Simulator s(model, ComputedTorqueController(model, small_sinusoid(n), gains), bad);
     FAIL() << "a negative Coulomb friction was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("joint_torque.coulomb[0]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("joint_torque: friction.coulomb[0]"), std::string::npos)
+        << e.what();
   }
 }
 

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -374,12 +375,14 @@ TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
   write_text(dir / "free/ft/calibrated.yaml",
              read_text(dir / "free/ft/config.yaml") + "calibration: ../calib.yaml\n");
   const EstimatorConfig calibrated = load_estimator_config(dir / "free/ft/calibrated.yaml");
-  const sim::JointTorqueModel& truth = load_scenario(dir / "free.yaml").simulation.joint_torque;
+  const std::optional<JointFriction> truth =
+      load_scenario(dir / "free.yaml").simulation.joint_torque.friction;
+  ASSERT_TRUE(truth.has_value());
   ASSERT_TRUE(calibrated.options.friction.has_value());
   const JointFriction& f = *calibrated.options.friction;
   for (int i = 0; i < 7; ++i) {
-    EXPECT_NEAR(f.viscous[i], truth.viscous[i], 0.05 * truth.viscous[i]) << "joint " << i + 1;
-    EXPECT_NEAR(f.coulomb[i], truth.coulomb[i], 0.05 * truth.coulomb[i]) << "joint " << i + 1;
+    EXPECT_NEAR(f.viscous[i], truth->viscous[i], 0.05 * truth->viscous[i]) << "joint " << i + 1;
+    EXPECT_NEAR(f.coulomb[i], truth->coulomb[i], 0.05 * truth->coulomb[i]) << "joint " << i + 1;
   }
   fs::remove_all(dir);
 }

@@ -2,11 +2,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "extwrench/core/sample.hpp"
 #include "extwrench/core/types.hpp"
 #include "extwrench/estimation/base_sensor.hpp"
+#include "extwrench/observer/friction.hpp"
 #include "extwrench/sim/random.hpp"
 
 namespace extwrench::sim {
@@ -40,24 +42,20 @@ struct EncoderModel {
 };
 
 /// The joint torques the robot logs beside the command τ that the link dynamics see: the
-/// friction its drives overcome, τ_f = D q̇ + F_c tanh(q̇ / v_s) of the true q̇ (a drive that
-/// delivers it on top of the command, as a joint-torque or current measurement then contains
-/// it), a constant offset per joint and white Gaussian noise: τ_log = τ + τ_f + o + σ n.
-/// Empty vectors: none. What a calibration identifies (docs/calibration.md).
+/// friction its drives overcome, τ_f of the true motion (the estimator's friction model,
+/// observer/friction.hpp: D q̇ + F_c s + o, any sign, the Dahl sign's state advanced by the true
+/// Δq from zero; a drive that delivers it on top of the command, as a joint-torque or current
+/// measurement then contains it), and white Gaussian noise: τ_log = τ + τ_f + σ n. What a
+/// calibration identifies (docs/calibration.md).
 struct JointTorqueModel {
-  VectorX viscous;                   ///< D_i [N m s/rad] (n, or empty)
-  VectorX coulomb;                   ///< F_c,i [N m] (n, or empty)
-  double smoothing_velocity = 0.03;  ///< v_s [rad/s] > 0
-  VectorX offset;                    ///< o_i [N m] (n, or empty)
-  double noise = 0.0;                ///< σ [N m] ≥ 0, every joint
+  std::optional<JointFriction> friction;  ///< none when empty
+  double noise = 0.0;                     ///< σ [N m] ≥ 0, every joint
 
-  /// Any term set.
-  [[nodiscard]] bool active() const noexcept;
-  /// Throws extwrench::Error naming `where` on sizes other than n (or empty), negative or
-  /// non-finite coefficients, v_s ≤ 0, σ < 0.
+  /// Friction or noise set.
+  [[nodiscard]] bool active() const noexcept { return friction.has_value() || noise > 0.0; }
+  /// Throws extwrench::Error naming `where` on a friction validate_friction refuses for n
+  /// joints, or σ < 0.
   void validate(int n, const std::string& where) const;
-  /// τ (the command, n) += τ_f(dq) + o + σ n, the noise drawn for every joint from `rng`.
-  void add_to(const VectorX& dq, Rng& rng, VectorX& tau) const noexcept;
 };
 
 /// Measured joint state from the true one, sample after sample.

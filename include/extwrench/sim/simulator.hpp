@@ -66,6 +66,8 @@ class Simulator final : public SampleSource {
   [[nodiscard]] const VectorX& dq() const { return dq_; }
 
  private:
+  void add_joint_torque_terms(VectorX& tau) noexcept;
+
   Model model_;
   ComputedTorqueController controller_;
   SimulationConfig config_;
@@ -74,6 +76,8 @@ class Simulator final : public SampleSource {
   Rng noise_;
   Rng torque_noise_;  ///< the joint torques' own stream: the base sensor's stays as without it
   VectorX q_, dq_, qm_, dqm_;
+  /// config_.joint_torque's friction: τ_f, and the Dahl sign's state with the q it was advanced to
+  VectorX tau_friction_, presliding_state_, presliding_q_;
   long k_ = 0;
   long num_samples_ = 0;
 };
