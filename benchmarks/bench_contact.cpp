@@ -4,6 +4,7 @@
 // Each estimator first runs kWarmup samples so that the contact is declared and every sample
 // timed takes the full path; the counters "contact", "link" and "surface" say that it did.
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <chrono>
@@ -151,6 +152,67 @@ void measure_latency(benchmark::State& state, std::size_t calls, Step&& step) {
   state.counters["clock_ns"] = static_cast<double>(clock[clock.size() / 2]);
 }
 
+/// Minor and major page faults of the calling thread so far.
+long thread_page_faults() {
+  rusage usage{};
+  getrusage(RUSAGE_THREAD, &usage);
+  return usage.ru_minflt + usage.ru_majflt;
+}
+
+// The first updates of a new estimator (issue 15, jitter): the first sample, the first sample in
+// contact (the first geometric isolation: lines against the collision shapes) and the worst of
+// the first kFirstCalls, each with the page faults of the thread during it. One estimator per
+// process run (Iterations(1)): later ones would find the process already warm. Run it several
+// times in fresh processes.
+void first_updates(benchmark::State& state, const Model& model, const GeometryModel& geometry,
+                   const EstimatorOptions& options, const Trajectory& tr) {
+  using Clock = std::chrono::steady_clock;
+  constexpr std::size_t kFirstCalls = 2000;
+  std::vector<std::int64_t> ns(kFirstCalls);
+  std::vector<long> faults(kFirstCalls);
+  std::size_t first_contact = kFirstCalls;
+  for (auto _ : state) {
+    state.PauseTiming();
+    ContactEstimator estimator(model, geometry, options);
+    const bool with_sensor = options.sensor.type != SensorType::kNone;
+    if (!estimator.reset(0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok()) {
+      state.SkipWithError("estimator reset failed");
+      return;
+    }
+    state.ResumeTiming();
+    for (std::size_t k = 1; k <= kFirstCalls; ++k) {
+      const std::size_t s = sample(k);
+      const long faults_before = thread_page_faults();
+      const auto t0 = Clock::now();
+      const Status st =
+          with_sensor ? estimator.update(stamp(k, tr), tr.q[s], tr.dq[s], tr.tau[s], tr.ft_S[s])
+                      : estimator.update(stamp(k, tr), tr.q[s], tr.dq[s], tr.tau[s]);
+      const auto t1 = Clock::now();
+      faults[k - 1] = thread_page_faults() - faults_before;
+      benchmark::DoNotOptimize(st);
+      ns[k - 1] = std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count();
+      if (first_contact == kFirstCalls && estimator.result().contact) first_contact = k - 1;
+    }
+  }
+  if (first_contact == kFirstCalls) {
+    state.SkipWithError("no contact declared in the first updates");
+    return;
+  }
+  const auto worst = std::max_element(ns.begin(), ns.end());
+  state.counters["first_ns"] = static_cast<double>(ns.front());
+  state.counters["first_faults"] = static_cast<double>(faults.front());
+  state.counters["contact_at"] = static_cast<double>(first_contact + 1);
+  state.counters["first_contact_ns"] = static_cast<double>(ns[first_contact]);
+  state.counters["first_contact_faults"] = static_cast<double>(faults[first_contact]);
+  state.counters["worst_ns"] = static_cast<double>(*worst);
+  state.counters["worst_at"] = static_cast<double>(worst - ns.begin() + 1);
+  long total_faults = 0;
+  for (const long f : faults) total_faults += f;
+  state.counters["faults"] = static_cast<double>(total_faults);
+  std::nth_element(ns.begin(), ns.begin() + kFirstCalls / 2, ns.end());
+  state.counters["median_ns"] = static_cast<double>(ns[kFirstCalls / 2]);
+}
+
 }  // namespace
 
 void register_contact_benchmarks() {
@@ -238,6 +300,24 @@ void register_contact_benchmarks() {
             o.isolation.rule = IsolationRule::kResidual;
             run_update(state, panda->model, panda->geometry, o, tr);
           });
+    }
+  }
+  // The first updates of a new estimator, on capsules and on the Panda's meshes.
+  for (const Config& c : {kTableI[0], kTableI[4]}) {
+    benchmark::RegisterBenchmark(
+        (std::string("BM_FirstUpdates_Ours/") + c.name + "/capsules").c_str(),
+        [&arm, &link6, c](benchmark::State& state) {
+          first_updates(state, arm.model, arm.geometry, options_for(c, link6), link6);
+        })
+        ->Iterations(1);
+    if (const MeshArm* panda = panda_arm(); panda != nullptr) {
+      const Trajectory& tr = *panda_trajectory();
+      benchmark::RegisterBenchmark(
+          (std::string("BM_FirstUpdates_Ours/") + c.name + "/panda_meshes").c_str(),
+          [panda, &tr, c](benchmark::State& state) {
+            first_updates(state, panda->model, panda->geometry, options_for(c, tr), tr);
+          })
+          ->Iterations(1);
     }
   }
   // Latency distributions: our full F/T unknown-point update, and KDL's estimator for contrast.
