@@ -9,9 +9,11 @@
 #include <algorithm>
 #include <chrono>
 #include <kdl/chainexternalwrenchestimator.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "extwrench/core/denormals.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "robots.hpp"
 
@@ -151,6 +153,36 @@ void measure_latency(benchmark::State& state, std::size_t calls, Step&& step) {
   state.counters["max_ns"] = static_cast<double>(ns.back());
   state.counters["clock_ns"] = static_cast<double>(clock[clock.size() / 2]);
 }
+
+// Subnormal numbers (issue 15, jitter): the F/T update on the link-6 trajectory with every joint
+// velocity replaced by `speed` (0, a subnormal 1e-310, or 1e-300, whose products underflow),
+// without and with ScopedFlushDenormals around the loop. Timing only: such velocities are not
+// the trajectory's, and the estimate is not meant to be right.
+void BM_FullUpdate_TinyVelocity(benchmark::State& state, double speed, bool flush) {
+  const PaperArm& arm = paper_arm();
+  const Trajectory& tr = link6_trajectory();
+  ContactEstimator estimator(arm.model, arm.geometry, options_for(kTableI[0], tr));
+  const VectorX dq = VectorX::Constant(arm.model.nq(), speed);
+  if (!estimator.reset(0.0, tr.q[0], dq, tr.tau[0]).ok()) {
+    state.SkipWithError("estimator reset failed");
+    return;
+  }
+  std::optional<ScopedFlushDenormals> guard;
+  if (flush) guard.emplace();
+  std::size_t k = 1;
+  for (auto _ : state) {
+    const std::size_t s = sample(k);
+    const Status st = estimator.update(stamp(k, tr), tr.q[s], dq, tr.tau[s], tr.ft_S[s]);
+    benchmark::DoNotOptimize(st);
+    ++k;
+  }
+  state.counters["contact"] = estimator.result().contact ? 1.0 : 0.0;
+}
+BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, zero, 0.0, false);
+BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, subnormal, 1e-310, false);
+BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, underflowing, 1e-300, false);
+BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, subnormal_flushed, 1e-310, true);
+BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, underflowing_flushed, 1e-300, true);
 
 /// Minor and major page faults of the calling thread so far.
 long thread_page_faults() {

@@ -13,6 +13,7 @@
 #include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/localization.hpp"
+#include "extwrench/geometry/ray.hpp"
 
 namespace extwrench {
 namespace {
@@ -37,6 +38,8 @@ double settle_time_of(const EstimatorOptions& options, const MomentumObserver& o
 
 }  // namespace
 
+void ContactEstimator::warm_up() const noexcept { warm_up_geometry(geometry_); }
+
 ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, EstimatorOptions options)
     : options_(std::move(options)),
       model_((validate(options_, model), std::move(model))),
@@ -58,6 +61,7 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
                 std::to_string(model_.num_bodies()));
   }
   isolation_rule_ = resolved_rule(options_.isolation, geometry_);
+  warm_up_geometry(geometry_);  // else the first contact pages in the ray casting code
   nominal_inertia_.reserve(model_.bodies.size());
   for (const Body& b : model_.bodies) nominal_inertia_.push_back(b.inertia);
   if (options_.friction) observer_.set_friction(*options_.friction);

@@ -187,4 +187,31 @@ bool first_entry_on_body(const GeometryModel& geometry, int body, const Pose& X_
   return hit;
 }
 
+void warm_up_geometry(const GeometryModel& geometry) noexcept {
+  const Pose X_WB;             // identity: the body's own frame
+  volatile double sink = 0.0;  // keeps the queries from being optimised away
+  for (const CollisionShape& shape : geometry.shapes) {
+    if (shape.body < 0 || shape.body >= static_cast<int>(geometry.body_shapes.size())) continue;
+    Vector3 centre_S = Vector3::Zero();
+    if (shape.type == ShapeType::kMesh && shape.mesh != nullptr &&
+        shape.mesh->vertices.cols() > 0) {
+      centre_S = shape.mesh->vertices.rowwise().mean();
+    }
+    const Vector3 centre_B = shape.placement.act(centre_S);
+    for (int axis = 0; axis < 3; ++axis) {
+      const Vector3 u = Vector3::Unit(axis);
+      const SurfacePointResult through =
+          intersect_line_with_body(geometry, shape.body, X_WB, centre_B, u);
+      LineHit entry;
+      const bool entered =
+          first_entry_on_body(geometry, shape.body, X_WB, centre_B, u, kInf, entry);
+      sink = sink + through.entry.lambda + (entered ? entry.lambda : 0.0);
+    }
+    // A line far outside every shape: the nearest-point search of a miss.
+    const SurfacePointResult miss = intersect_line_with_body(
+        geometry, shape.body, X_WB, centre_B + Vector3(1e3, 0.0, 0.0), Vector3::UnitZ());
+    sink = sink + miss.distance;
+  }
+}
+
 }  // namespace extwrench

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 
+#include "extwrench/core/denormals.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "reference/kdl_reference.hpp"
@@ -185,6 +186,83 @@ TEST(EstimatorRealTime, AfterNaNOrInfInputsTheNextGoodSampleIsBitIdenticalToACle
       ASSERT_TRUE(clean.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
       ASSERT_TRUE(dirty.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
       ASSERT_TRUE(same_bits(clean.result(), dirty.result())) << describe(c) << " sample " << k;
+    }
+  }
+}
+
+// warm_up() between samples (on the loop's thread, before the loop or after an idle phase)
+// changes no result and allocates nothing.
+TEST(EstimatorRealTime, WarmUpBetweenSamplesChangesNothingAndAllocatesNothing) {
+  const Samples s = make_samples(60, 6, 5);
+  const Model model = test::paper_arm_model();
+  for (const Config& c : all_configs()) {
+    const EstimatorOptions o = options_for(c);
+    ContactEstimator plain(model, test::paper_arm_capsules(model), o);
+    ContactEstimator warmed(model, test::paper_arm_capsules(model), o);
+    ASSERT_TRUE(plain.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    ASSERT_TRUE(warmed.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    std::size_t allocations = 0;
+    for (int k = 1; k < 60; ++k) {
+      if (k % 10 == 0) {
+        test::AllocationCounter counter;
+        warmed.warm_up();
+        allocations += counter.count();
+      }
+      const double t = k * 1e-3;
+      ASSERT_TRUE(plain.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(warmed.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(same_bits(plain.result(), warmed.result())) << describe(c) << " sample " << k;
+    }
+    if (test::allocation_counting_available()) {
+      EXPECT_EQ(allocations, 0u) << describe(c);
+    }
+    EXPECT_TRUE(warmed.result().contact) << describe(c);
+  }
+}
+
+// The flush-to-zero guard: subnormal results become 0 and subnormal operands read as 0 while it
+// lives, the thread's mode comes back after; the estimator then treats subnormal velocities as
+// the zeros they read as, and changes nothing on samples without subnormals.
+TEST(EstimatorRealTime, FlushDenormalsGuardFlushesWhileAliveAndRestoresTheMode) {
+  if (!ScopedFlushDenormals::supported()) GTEST_SKIP() << "no flush-to-zero on this platform";
+  volatile double smallest_normal = std::numeric_limits<double>::min();
+  volatile double half = 0.5;
+  const double subnormal = smallest_normal * half;
+  ASSERT_GT(subnormal, 0.0);
+  ASSERT_LT(subnormal, smallest_normal);
+  volatile double subnormal_operand = subnormal;
+  {
+    const ScopedFlushDenormals guard;
+    EXPECT_EQ(smallest_normal * half, 0.0);                           // FTZ
+    EXPECT_EQ(subnormal_operand + smallest_normal, smallest_normal);  // DAZ
+  }
+  EXPECT_EQ(smallest_normal * half, subnormal);  // the mode is restored
+  EXPECT_EQ(subnormal_operand + smallest_normal, smallest_normal + subnormal);
+
+  const Samples s = make_samples(40, 6, 6);
+  const Model model = test::paper_arm_model();
+  const VectorX zero = VectorX::Zero(7);
+  const VectorX subnormal_dq = VectorX::Constant(7, subnormal);
+  for (const Config& c : all_configs()) {
+    const EstimatorOptions o = options_for(c);
+    ContactEstimator plain(model, test::paper_arm_capsules(model), o);
+    ContactEstimator at_rest(model, test::paper_arm_capsules(model), o);
+    ContactEstimator guarded(model, test::paper_arm_capsules(model), o);
+    ContactEstimator subnormal_rest(model, test::paper_arm_capsules(model), o);
+    ASSERT_TRUE(plain.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    ASSERT_TRUE(at_rest.reset(0.0, s.q[0], zero, s.tau[0]).ok());
+    const ScopedFlushDenormals guard;
+    ASSERT_TRUE(guarded.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+    ASSERT_TRUE(subnormal_rest.reset(0.0, s.q[0], subnormal_dq, s.tau[0]).ok());
+    for (int k = 1; k < 40; ++k) {
+      const double t = k * 1e-3;
+      ASSERT_TRUE(plain.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(guarded.update(t, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(same_bits(plain.result(), guarded.result())) << describe(c) << " sample " << k;
+      ASSERT_TRUE(at_rest.update(t, s.q[k], zero, s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(subnormal_rest.update(t, s.q[k], subnormal_dq, s.tau[k], s.reading[k]).ok());
+      ASSERT_TRUE(same_bits(at_rest.result(), subnormal_rest.result()))
+          << describe(c) << " sample " << k;
     }
   }
 }

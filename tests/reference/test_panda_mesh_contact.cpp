@@ -3,6 +3,7 @@
 // surface is located at its pushing point, never at the pulling one, and a line that misses the
 // link says so. The wrench data come from KDL (its own URDF parser, RNE with the wrench).
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <filesystem>
 
@@ -123,6 +124,65 @@ TEST(PandaMeshContact, ALineThatMissesTheLinkReportsTheNearestSurfacePoint) {
   EXPECT_FALSE(e.has(EstimateFlag::kSurfacePoint));
   EXPECT_GT(e.surface_distance, 0.3);
   EXPECT_TRUE(e.point_W.allFinite());
+}
+
+long thread_page_faults() {
+  rusage usage{};
+  getrusage(RUSAGE_THREAD, &usage);
+  return usage.ru_minflt + usage.ru_majflt;
+}
+
+// The constructor's warm_up: the first contact's update finds the ray casting code (Embree's
+// traversal kernels, first used by that update) paged in. Without it that update took 4-5 page
+// faults in libembree (BM_FirstUpdates_Ours, BENCHMARKS.md). ctest runs each test in its own
+// process, so nothing before this test has cast a ray.
+TEST(PandaMeshContact, TheFirstContactFindsTheRayCastingCodePagedIn) {
+  if (!std::filesystem::exists(kUrdf)) GTEST_SKIP() << "shared models absent";
+  const RobotDescription robot = panda_chain();
+  const Model& model = robot.model;
+  test::KdlReference kdl(model);
+  EstimatorOptions opt;
+  opt.sensor.type = SensorType::kForceTorque;
+  opt.detection.tau_min = VectorX::Constant(1, 1e-9);
+  opt.detection.f_min = 1e-9;
+  opt.detection.min_duration = 0.0;
+  const ContactEstimator prototype(model, robot.geometry, opt);
+  VectorX q(7);
+  q << 0.1, -0.4, 0.2, -2.0, 0.1, 1.6, 0.5;
+  const VectorX zero = VectorX::Zero(7);
+  // 15 N pushing along −x of link 6's frame on the face of its mesh that looks along +x.
+  const int link = 6;
+  const CollisionShape* mesh_shape = nullptr;
+  for (int s : robot.geometry.body_shapes[link]) {
+    const CollisionShape& shape = robot.geometry.shapes[static_cast<std::size_t>(s)];
+    if (shape.type == ShapeType::kMesh && shape.mesh) mesh_shape = &shape;
+  }
+  ASSERT_NE(mesh_shape, nullptr);
+  Vector3 p_L = Vector3::Constant(-1e300);
+  for (Eigen::Index v = 0; v < mesh_shape->mesh->vertices.cols(); ++v) {
+    const Vector3 p = mesh_shape->placement.act(mesh_shape->mesh->vertices.col(v));
+    if (p.x() > p_L.x()) p_L = p;
+  }
+  const Pose X_WL = kdl.compute_body_pose(q, link);
+  const Vector3 F = X_WL.rotation * Vector3(-15.0, 4.0, 0.0);
+  const auto ref = kdl.compute(q, zero, zero, link, F, X_WL.act(p_L), Vector3::Zero());
+  const Vector6 reading = test::to_sensor_frame(ref.reading_W, Pose{});
+  // Copies (their buffers touched once by a first update at rest), then the contact, measured.
+  ContactEstimator est = prototype;
+  const auto rest = kdl.compute(q, zero, zero, link, Vector3::Zero(), p_L, Vector3::Zero());
+  ASSERT_TRUE(est.update_with(0.0, q, zero, zero, zero, rest.tau,
+                              test::to_sensor_frame(rest.reading_W, Pose{}))
+                  .ok());
+  ASSERT_FALSE(est.result().contact);
+  const long before = thread_page_faults();
+  const Status status = est.update_with(1e-3, q, zero, zero, ref.tau_ext, ref.tau, reading);
+  const long faults = thread_page_faults() - before;
+  ASSERT_TRUE(status.ok());
+  const ContactEstimate& e = est.result();
+  ASSERT_TRUE(e.contact);
+  ASSERT_EQ(e.link, link);
+  ASSERT_TRUE(e.has(EstimateFlag::kSurfacePoint));  // the update did cast against the mesh
+  EXPECT_EQ(faults, 0) << "page faults in the first contact's update";
 }
 
 }  // namespace

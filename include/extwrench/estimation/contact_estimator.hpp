@@ -91,6 +91,11 @@ class ContactEstimator {
   /// Removes the payload (same continuity as set_payload).
   void clear_payload() noexcept { apply_payload(-1, nullptr); }
 
+  /// Pages in the code and data the first contact needs (warm_up_geometry on this estimator's
+  /// collision shapes), without changing any state. The constructor does it; call it again on
+  /// the loop's thread right before the loop (docs/estimator.md#hard-real-time).
+  void warm_up() const noexcept;
+
   [[nodiscard]] const ContactEstimate& result() const noexcept { return out_; }
   /// The model in use (payload included); body names: model().bodies[result().link].name.
   [[nodiscard]] const Model& model() const noexcept { return model_; }

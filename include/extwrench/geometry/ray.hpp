@@ -108,4 +108,15 @@ enum class OnMiss {
                                        const Vector3& point_on_line_W, const Vector3& direction_W,
                                        double max_lambda, LineHit& entry) noexcept;
 
+/// Runs the line queries above once against every collision shape (through each shape's centre
+/// along the body's three axes, and one line that misses it), results discarded, so that the
+/// code they use (the primitives, the mesh caster: Embree's traversal kernels) is paged in
+/// before a real-time loop rather than at the first contact. ContactEstimator's constructor
+/// calls it; call it (or ContactEstimator::warm_up) again on the loop's thread before the loop,
+/// and after an idle phase long enough for the kernel to reclaim pages when memory is not
+/// locked (docs/estimator.md#hard-real-time). Measured on the Panda's meshes: the first contact's
+/// update otherwise pays 4–5 page faults in libembree, 36–50 µs instead of 5–16 µs (BENCHMARKS.md).
+/// noexcept, no allocation; bounded: 7 queries per shape.
+void warm_up_geometry(const GeometryModel& geometry) noexcept;
+
 }  // namespace extwrench
