@@ -20,6 +20,23 @@ using test::SeededRng;
 using test::panda_chain;
 const std::filesystem::path kUrdf = test::panda_urdf();
 
+/// A base F/T sensor and thresholds that declare any contact on its first sample.
+EstimatorOptions sensitive_ft_options() {
+  EstimatorOptions opt;
+  opt.sensor.type = SensorType::kForceTorque;
+  opt.detection.tau_min = VectorX::Constant(1, 1e-9);
+  opt.detection.f_min = 1e-9;
+  opt.detection.min_duration = 0.0;
+  return opt;
+}
+
+/// A configuration away from the joint limits and singularities.
+VectorX test_configuration() {
+  VectorX q(7);
+  q << 0.1, -0.4, 0.2, -2.0, 0.1, 1.6, 0.5;
+  return q;
+}
+
 TEST(PandaMeshContact, PushingPointIsNeverConfusedWithThePullingOne) {
   if (!std::filesystem::exists(kUrdf)) GTEST_SKIP() << "shared models absent";
   const RobotDescription robot = panda_chain();
@@ -27,12 +44,7 @@ TEST(PandaMeshContact, PushingPointIsNeverConfusedWithThePullingOne) {
   ASSERT_EQ(model.nq(), 7);
   ASSERT_TRUE(model.is_serial_chain());
   test::KdlReference kdl(model);
-  EstimatorOptions opt;
-  opt.sensor.type = SensorType::kForceTorque;
-  opt.detection.tau_min = VectorX::Constant(1, 1e-9);
-  opt.detection.f_min = 1e-9;
-  opt.detection.min_duration = 0.0;
-  ContactEstimator est(model, robot.geometry, opt);
+  ContactEstimator est(model, robot.geometry, sensitive_ft_options());
   SeededRng rng(31);
   double t = 0.0;
   int exact = 0, earlier = 0, total = 0;
@@ -101,13 +113,8 @@ TEST(PandaMeshContact, ALineThatMissesTheLinkReportsTheNearestSurfacePoint) {
   const RobotDescription robot = panda_chain();
   const Model& model = robot.model;
   test::KdlReference kdl(model);
-  EstimatorOptions opt;
-  opt.sensor.type = SensorType::kForceTorque;
-  opt.detection.tau_min = VectorX::Constant(1, 1e-9);
-  opt.detection.min_duration = 0.0;
-  ContactEstimator est(model, robot.geometry, opt);
-  VectorX q(7);
-  q << 0.1, -0.4, 0.2, -2.0, 0.1, 1.6, 0.5;
+  ContactEstimator est(model, robot.geometry, sensitive_ft_options());
+  const VectorX q = test_configuration();
   const VectorX zero = VectorX::Zero(7);
   // A force along y applied to a point rigidly attached to link 4, 0.6 m along its x axis: its
   // line stays ~0.6 m from the link's mesh, and τ_ext,4 = 7.2 N m isolates link 4.
@@ -141,14 +148,8 @@ TEST(PandaMeshContact, TheFirstContactFindsTheRayCastingCodePagedIn) {
   const RobotDescription robot = panda_chain();
   const Model& model = robot.model;
   test::KdlReference kdl(model);
-  EstimatorOptions opt;
-  opt.sensor.type = SensorType::kForceTorque;
-  opt.detection.tau_min = VectorX::Constant(1, 1e-9);
-  opt.detection.f_min = 1e-9;
-  opt.detection.min_duration = 0.0;
-  const ContactEstimator prototype(model, robot.geometry, opt);
-  VectorX q(7);
-  q << 0.1, -0.4, 0.2, -2.0, 0.1, 1.6, 0.5;
+  const ContactEstimator prototype(model, robot.geometry, sensitive_ft_options());
+  const VectorX q = test_configuration();
   const VectorX zero = VectorX::Zero(7);
   // 15 N pushing along −x of link 6's frame on the face of its mesh that looks along +x.
   const int link = 6;
