@@ -11,6 +11,7 @@
 #include "extwrench/io/robot_loader.hpp"
 #include "reference/kdl_reference.hpp"
 #include "reference/panda_chain.hpp"
+#include "support/build_info.hpp"
 
 namespace extwrench {
 namespace {
@@ -183,6 +184,8 @@ TEST(PandaMeshContact, TheFirstContactFindsTheRayCastingCodePagedIn) {
   ASSERT_TRUE(e.contact);
   ASSERT_EQ(e.link, link);
   ASSERT_TRUE(e.has(EstimateFlag::kSurfacePoint));  // the update did cast against the mesh
+  // AddressSanitizer maps its shadow memory lazily: its own page faults say nothing of ours.
+  if (test::kSanitizerBuild) return;
   EXPECT_EQ(faults, 0) << "page faults in the first contact's update";
 }
 
