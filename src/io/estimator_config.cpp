@@ -135,9 +135,10 @@ void calibrated_noise(const YAML::Node& root, const Calibration& cal, EstimatorO
 // `calibration: CALIB.yaml` (relative to the configuration): friction, thresholds and sensor
 // bias from `extwrench calibrate`. Keys the configuration sets itself (friction,
 // detection.tau_min, detection.tau_per_speed, detection.f_min, sensor.tare) win over the
-// calibration's; a configuration setting tau_min alone gets constant thresholds.
-void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::path& source, int n,
-                      EstimatorOptions& o) {
+// calibration's; a configuration setting tau_min alone gets constant thresholds. Returns the
+// file's path.
+fs::path read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::path& source,
+                          int n, EstimatorOptions& o) {
   const YAML::Node node = root["calibration"];
   const fs::path rel = rd.string(node, "calibration");
   const fs::path path = rel.is_absolute() ? rel : source.parent_path() / rel;
@@ -193,6 +194,7 @@ void read_calibration(const YamlReader& rd, const YAML::Node& root, const fs::pa
     if (!(det && det["f_min"])) o.detection.f_min = cal.force_threshold;
     if (o.sensor.tare_samples == 0) o.sensor.bias_S = cal.sensor_bias_S;
   }
+  return path;
 }
 
 // "model" (the robot file's), or one number per joint (or one for all) [kg m^2 | kg]: the
@@ -353,7 +355,7 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   if (root["isolation"]) read_isolation(rd, root["isolation"], o.isolation);
   if (root["uncertainty"]) read_uncertainty(rd, root["uncertainty"], n, o.uncertainty);
   if (root["drift"]) read_drift(rd, root["drift"], o.drift);
-  if (root["calibration"]) read_calibration(rd, root, source, n, o);
+  if (root["calibration"]) cfg.calibration_path = read_calibration(rd, root, source, n, o);
 
   // The remaining checks need the whole picture (serial chain, sizes).
   try {

@@ -16,7 +16,11 @@
 #include <limits>
 #include <numbers>
 #include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "extwrench/app/replay.hpp"
 #include "extwrench/app/scenario_run.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
@@ -615,6 +619,47 @@ TEST_F(Replay, LongLogReplaysInTheMemoryOfAShortOne) {
   std::printf("peak RSS: 60000 rows %ld kB, %ld rows %ld kB\n", short_kb, big_rows, long_kb);
   EXPECT_LE(long_kb, short_kb * 1.10);
   fs::remove_all(dir);
+}
+
+// The note of a log without truth whose contacts look like the model's error (docs/cli.md): the
+// real Panda's uncalibrated free motion (3623 of 9752 samples, 42 episodes in 10.5 s, 4 links with
+// 2 % of them; measured with `estimate`, K = 50) and the paper arm's unmodelled friction (99 % of
+// the samples, 1-3 episodes, on 3-5 links) get it; one long push on one link, a few pushes an hour
+// and any log with truth do not.
+TEST(FrequentAlarmsNote, SaysCalibrateOnlyForTheModelErrorsPatterns) {
+  const auto result = [](long rows, long contact, long episodes, double seconds,
+                         std::vector<long> by_link, bool truth = false) {
+    ReplayResult r;
+    r.rows = rows;
+    r.contact_samples = contact;
+    r.contact_episodes = episodes;
+    r.report.t_begin = 0.0;
+    r.report.t_end = seconds;
+    r.contact_samples_by_link = std::move(by_link);
+    r.has_truth = truth;
+    return r;
+  };
+  const ReplayResult panda = result(9752, 3623, 42, 10.5, {0, 0, 1445, 54, 1128, 0, 329, 667});
+  const std::string note = frequent_alarms_note(panda);
+  EXPECT_NE(note.find("contact declared on 37 % of the samples, 42 times in 10.5 s, on 4 links"),
+            std::string::npos)
+      << note;
+  EXPECT_NE(note.find("extwrench calibrate"), std::string::npos) << note;
+  EXPECT_NE(
+      frequent_alarms_note(result(20001, 19840, 3, 20.0, {4, 58, 1365, 916, 17358, 115, 22, 2})),
+      "");
+  // A push held on one link all along (the paper's experiment), and on two links.
+  EXPECT_EQ(frequent_alarms_note(result(6001, 6001, 1, 6.0, {0, 0, 0, 0, 0, 0, 5990, 11})), "");
+  EXPECT_EQ(frequent_alarms_note(result(4001, 3000, 2, 4.0, {0, 0, 0, 0, 1500, 0, 1500, 0})), "");
+  // Pushes now and then: 30 in an hour.
+  EXPECT_EQ(frequent_alarms_note(
+                result(3600000, 30000, 30, 3600.0, {0, 0, 0, 10000, 10000, 10000, 0, 0})),
+            "");
+  // Nine quick alarms, and the same log with truth (a simulation: its metrics say it all).
+  EXPECT_EQ(frequent_alarms_note(result(9752, 300, 9, 10.5, {0, 100, 100, 100, 0, 0, 0, 0})), "");
+  EXPECT_EQ(
+      frequent_alarms_note(result(9752, 3623, 42, 10.5, {0, 0, 1445, 54, 1128, 0, 329, 667}, true)),
+      "");
 }
 
 }  // namespace

@@ -45,6 +45,9 @@ struct ReplayOptions {
   bool ignore_extra_joint_columns = false;
   /// Warn on stderr when most contact samples carry `disagreement` (wrong sensor pose...).
   bool warn_disagreement = true;
+  /// Note on stderr when a log without truth has contacts declared anew again and again
+  /// (frequent_alarms_note): `estimate` sets it when the configuration includes no calibration.
+  bool note_frequent_alarms = false;
   /// Where the notes and warnings go (ignored columns, figures not drawn, disagreement); null:
   /// std::cerr. Replays running in parallel each get their own buffer, printed in order.
   std::ostream* messages = nullptr;
@@ -61,6 +64,9 @@ struct ReplayResult {
   std::vector<std::string> figure_failures;  ///< one per figure not drawn (warned on stderr)
   long contact_samples = 0;                  ///< estimates with a contact declared
   long disagreement_samples = 0;             ///< of those, flagged `disagreement`
+  long contact_episodes = 0;  ///< contacts declared anew (a contact sample after a free one)
+  /// Contact samples by the estimate's link, index 0..n (0: link 0, seen by the base sensor only).
+  std::vector<long> contact_samples_by_link;
   /// disagreement_samples / contact_samples (0 without contact).
   [[nodiscard]] double disagreement_fraction() const {
     return contact_samples > 0
@@ -73,6 +79,12 @@ struct ReplayResult {
 /// base sensor and the joint residual tell different stories), naming the likely causes; empty
 /// when there is nothing to warn about (fewer than half, or too few contact samples).
 [[nodiscard]] std::string disagreement_warning(const ReplayResult& result);
+
+/// The note for a log without truth whose contacts look like a model's error rather than a
+/// touch: declared anew at least once a second (10 times or more), or on most samples spread over
+/// three links or more (each with 2 % of the contact samples); with the remedy (calibrate on a
+/// contact-free log, docs/calibration.md). Empty otherwise, and for logs with truth.
+[[nodiscard]] std::string frequent_alarms_note(const ReplayResult& result);
 
 /// Reads `options.log` row by row, runs a ContactEstimator built from (model, geometry,
 /// estimator) on it, writes out_dir/estimates.csv, and with truth columns out_dir/metrics.json;

@@ -44,6 +44,8 @@ struct EstimatorConfig {
   /// Where options.sensor.X_WS came from: "sensor.pose" when the file gives it, else the rule
   /// of default_sensor_pose() in words (printed at the start of a replay).
   std::string sensor_pose_source;
+  /// The calibration file the configuration includes (`calibration:`, resolved); empty: none.
+  std::filesystem::path calibration_path;
 };
 
 /// Which rule default_sensor_pose() (estimation/base_sensor.hpp) applies to `model`, in words
