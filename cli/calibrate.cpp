@@ -7,14 +7,13 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "commands.hpp"
-#include "extwrench/calibration/holdout.hpp"
+#include "extwrench/app/calibrate_log.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/calibration_file.hpp"
 #include "extwrench/io/estimator_config.hpp"
-#include "extwrench/io/input_file.hpp"
-#include "extwrench/io/log.hpp"
 
 namespace extwrench::cli {
 namespace {
@@ -32,14 +31,6 @@ struct CalibrateOptions {
   bool inertia = false;
   std::vector<std::filesystem::path> package_path;
 };
-
-std::vector<Sample> read_log(const std::filesystem::path& path, const Model& model) {
-  LogReader reader(path, model);
-  std::vector<Sample> samples;
-  Sample s;
-  while (reader.next(s)) samples.push_back(s);
-  return samples;
-}
 
 // The report's numbers: four significant digits, right-aligned in `width` columns (the exact
 // values are in CALIB.yaml).
@@ -153,15 +144,9 @@ void run_calibrate(const CalibrateOptions& opt) {
   if (!(opt.holdout >= 0.0 && opt.holdout < 1.0))
     throw UsageError("--holdout: expected a fraction in [0, 1)");
   CalibrationOptions co;
-  if (opt.sign == "tanh") {
-    co.sign = SmoothSign::kTanh;
-  } else if (opt.sign == "sigmoid") {
-    co.sign = SmoothSign::kSigmoid;
-  } else if (opt.sign == "dahl") {
-    co.sign = SmoothSign::kDahl;
-  } else {
-    throw UsageError("--sign: expected tanh, sigmoid or dahl, got '" + opt.sign + "'");
-  }
+  const std::optional<SmoothSign> sign = calibration_sign(opt.sign);
+  if (!sign) throw UsageError("--sign: expected tanh, sigmoid or dahl, got '" + opt.sign + "'");
+  co.sign = *sign;
   if (co.sign == SmoothSign::kDahl && opt.smoothing_velocity > 0)
     throw UsageError(
         "--smoothing-velocity: not used with --sign dahl (its presliding "
@@ -180,46 +165,29 @@ void run_calibrate(const CalibrateOptions& opt) {
   co.known_external_torque = opt.known_torque;
   co.inertia_correction = opt.inertia;
   co.false_alarms_per_hour = opt.false_alarms_per_hour;
-  if (opt.thresholds == "auto") {
-    co.thresholds = ThresholdModel::kAuto;
-  } else if (opt.thresholds == "constant") {
-    co.thresholds = ThresholdModel::kConstant;
-  } else if (opt.thresholds == "speed") {
-    co.thresholds = ThresholdModel::kSpeed;
-  } else {
+  const std::optional<ThresholdModel> thresholds = threshold_model(opt.thresholds);
+  if (!thresholds) {
     throw UsageError("--thresholds: expected auto, constant or speed, got '" + opt.thresholds +
                      "'");
   }
+  co.thresholds = *thresholds;
   LoadOptions load;
   load.package_path = opt.package_path;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
-  check_input_file(opt.log, "log");
   const auto start = std::chrono::steady_clock::now();
-  const std::vector<Sample> samples = read_log(opt.log, config.robot.model);
-  const auto fit_count =
-      static_cast<std::size_t>(static_cast<double>(samples.size()) * (1.0 - opt.holdout));
-  const std::vector<Sample> fit(samples.begin(),
-                                samples.begin() + static_cast<std::ptrdiff_t>(fit_count));
-  Calibration cal;
-  try {
-    cal = calibrate(config.robot.model, config.options, fit, co);
-  } catch (const Error& e) {
-    throw Error(opt.log.string() + ": " + e.what());
-  }
-  cal.source = opt.log.string();
-  std::optional<HoldoutReport> holdout;
-  if (opt.holdout > 0)
-    holdout = validate_holdout(config.robot.model, config.options, cal, samples, fit_count);
+  const CalibrateLogResult run = calibrate_log(config, opt.log, co, opt.holdout);
+  const Calibration& cal = run.calibration;
+  const HoldoutReport* holdout = run.holdout ? &*run.holdout : nullptr;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::ofstream out(opt.out);
   if (!out) throw Error(opt.out.string() + ": cannot write");
-  out << calibration_to_yaml(cal, holdout ? &*holdout : nullptr);
+  out << calibration_to_yaml(cal, holdout);
   if (!out) throw Error(opt.out.string() + ": write failed");
-  std::cout << "extwrench calibrate: " << samples.size() << " rows, fit on " << fit.size() << " ("
+  std::cout << "extwrench calibrate: " << run.rows << " rows, fit on " << run.fit_rows << " ("
             << cal.samples_used << " used) in " << cell(seconds, 0) << " s -> " << opt.out.string()
             << "\n";
-  print_report(cal, holdout ? &*holdout : nullptr, opt.known_torque);
+  print_report(cal, holdout, opt.known_torque);
 }
 
 }  // namespace

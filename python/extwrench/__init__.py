@@ -22,6 +22,7 @@ from ._extwrench import (  # noqa: F401  (re-exported)
     Robot,
     __version__,
     bias,
+    calibrate,
     coriolis_matrix,
     crba,
     forward_dynamics,
@@ -43,7 +44,7 @@ gravity_torques = gravity
 
 __all__ = [
     "ContactEstimator", "Error", "Estimate", "ExternalWrench", "Robot", "__version__", "bias",
-    "bias_torques", "coriolis_matrix", "crba", "estimate", "forward_dynamics",
+    "bias_torques", "calibrate", "coriolis_matrix", "crba", "estimate", "forward_dynamics",
     "forward_kinematics", "gravity", "gravity_torques", "jacobian", "load_robot", "metrics",
     "read_log", "rnea", "sensor_reading", "simulate", "write_estimates",
 ]

@@ -12,6 +12,7 @@ from ._extwrench import (
     Robot as Robot,
     __version__ as __version__,
     bias as bias,
+    calibrate as calibrate,
     coriolis_matrix as coriolis_matrix,
     crba as crba,
     forward_dynamics as forward_dynamics,

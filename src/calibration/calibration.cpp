@@ -473,6 +473,20 @@ void friction_and_thresholds(const std::vector<JointFrictionFit>& fits,
 
 }  // namespace
 
+std::optional<SmoothSign> calibration_sign(std::string_view name) {
+  if (name == "tanh") return SmoothSign::kTanh;
+  if (name == "sigmoid") return SmoothSign::kSigmoid;
+  if (name == "dahl") return SmoothSign::kDahl;
+  return std::nullopt;
+}
+
+std::optional<ThresholdModel> threshold_model(std::string_view name) {
+  if (name == "auto") return ThresholdModel::kAuto;
+  if (name == "constant") return ThresholdModel::kConstant;
+  if (name == "speed") return ThresholdModel::kSpeed;
+  return std::nullopt;
+}
+
 Calibration calibrate(const Model& model, const EstimatorOptions& options,
                       const std::vector<Sample>& samples, const CalibrationOptions& o) {
   const int n = model.nq();

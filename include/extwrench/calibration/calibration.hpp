@@ -16,7 +16,9 @@
 // is chosen per joint on a grid, or set.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "extwrench/core/sample.hpp"
@@ -31,6 +33,13 @@ enum class ThresholdModel {
   kConstant,  ///< τ_thr = a
   kSpeed,     ///< τ_thr = a + b|q̇| on every joint
 };
+
+/// The sign of a calibration by name, as the command line and Python take it: "tanh",
+/// "sigmoid" or "dahl"; nullopt for anything else.
+[[nodiscard]] std::optional<SmoothSign> calibration_sign(std::string_view name);
+
+/// The threshold form by name: "auto", "constant" or "speed"; nullopt for anything else.
+[[nodiscard]] std::optional<ThresholdModel> threshold_model(std::string_view name);
 
 struct CalibrationOptions {
   ThresholdModel thresholds = ThresholdModel::kAuto;
