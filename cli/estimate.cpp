@@ -102,8 +102,9 @@ std::vector<std::filesystem::path> output_dirs(const LogInputs& in,
   return dirs;
 }
 
-// "contact: 586 of 4001 samples (14.6 %), 2 episodes; link4 223, link6 354, link5 5": what a log
-// without truth says of itself at a glance (links in body order, those never declared left out).
+// "contact: 586 of 4001 samples (14.6 %), 2 episodes; link4 223, link5 5, link6 354": the
+// estimates at a glance, with or without truth (links in body order, those never declared left
+// out).
 std::string contact_summary(const ReplayResult& r, const Model& model) {
   char head[128];
   std::snprintf(

@@ -6,13 +6,14 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/input_file.hpp"
 #include "extwrench/io/log.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
 
 CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::filesystem::path& log,
                                  const CalibrationOptions& options, double holdout) {
   if (!(holdout >= 0.0 && holdout < 1.0))
-    throw Error("holdout: expected a fraction in [0, 1), got " + std::to_string(holdout));
+    throw Error("holdout: expected a fraction in [0, 1), got " + format_number(holdout));
   check_input_file(log, "log");
   const Model& model = config.robot.model;
   std::vector<Sample> samples;

@@ -45,7 +45,7 @@ struct ReplayOptions {
   bool ignore_extra_joint_columns = false;
   /// Warn on stderr when most contact samples carry `disagreement` (wrong sensor pose...).
   bool warn_disagreement = true;
-  /// Note on stderr when a log without truth has contacts declared anew again and again
+  /// Note on stderr when a log without truth has contacts that look like the model's error
   /// (frequent_alarms_note): `estimate` sets it when the configuration includes no calibration.
   bool note_frequent_alarms = false;
   /// Where the notes and warnings go (ignored columns, figures not drawn, disagreement); null:
