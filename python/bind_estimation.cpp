@@ -247,6 +247,11 @@ Returns an Estimate. Bad input raises ValueError naming it; the state is then un
       .def(
           "request_tare", [](Estimator& e, int samples) { e.estimator.request_tare(samples); },
           py::arg("samples"))
+      .def(
+          "warm_up", [](const Estimator& e) { e.estimator.warm_up(); },
+          "Pages in what the first contact needs (the ray casting against the collision shapes); "
+          "the constructor did it once. Call it from the loop's thread after a long idle phase "
+          "(docs/estimator.md, Hard real time). Changes no estimate.")
       .def_property(
           "sensor_bias", [](const Estimator& e) { return Vector6(e.estimator.sensor_bias()); },
           [](Estimator& e, const py::handle& bias) {
