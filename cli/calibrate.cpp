@@ -1,5 +1,6 @@
 // extwrench calibrate: friction, offsets, sensor bias, noise and thresholds from a contact-free
 // log (docs/calibration.md), written as CALIB.yaml for `calibration:` in a configuration.
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
@@ -8,6 +9,8 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <string>
+#include <string_view>
 
 #include "commands.hpp"
 #include "extwrench/app/calibrate_log.hpp"
@@ -20,17 +23,18 @@ namespace {
 
 struct CalibrateOptions {
   std::filesystem::path config, log, out;
-  double holdout = 0.0;
-  std::string sign = "tanh";
-  double smoothing_velocity = 0.0;
-  double presliding_displacement = 0.0;
-  double false_alarms_per_hour = 1.0;
-  std::string thresholds = "auto";
-  bool payload = false;
-  bool known_torque = false;
-  bool inertia = false;
+  CalibrateArguments arguments;
   std::vector<std::filesystem::path> package_path;
 };
+
+// "smoothing_velocity" -> "--smoothing-velocity"; values as typed; "--sign dahl".
+std::string option_name(std::string_view key) {
+  std::string name = "--" + std::string(key);
+  std::replace(name.begin(), name.end(), '_', '-');
+  return name;
+}
+std::string option_value(std::string_view text) { return std::string(text); }
+constexpr ArgumentSpelling kOptionSpelling{option_name, option_value, " "};
 
 // The report's numbers: four significant digits, right-aligned in `width` columns (the exact
 // values are in CALIB.yaml).
@@ -141,41 +145,17 @@ void print_report(const Calibration& c, const HoldoutReport* h, bool in_contact)
 }
 
 void run_calibrate(const CalibrateOptions& opt) {
-  if (!(opt.holdout >= 0.0 && opt.holdout < 1.0))
-    throw UsageError("--holdout: expected a fraction in [0, 1)");
   CalibrationOptions co;
-  const std::optional<SmoothSign> sign = calibration_sign(opt.sign);
-  if (!sign) throw UsageError("--sign: expected tanh, sigmoid or dahl, got '" + opt.sign + "'");
-  co.sign = *sign;
-  if (co.sign == SmoothSign::kDahl && opt.smoothing_velocity > 0)
-    throw UsageError(
-        "--smoothing-velocity: not used with --sign dahl (its presliding "
-        "displacement is chosen per joint, or fixed by --presliding-displacement)");
-  if (co.sign != SmoothSign::kDahl && opt.presliding_displacement > 0)
-    throw UsageError("--presliding-displacement: only with --sign dahl");
-  if (opt.smoothing_velocity < 0) throw UsageError("--smoothing-velocity: expected a value >= 0");
-  if (opt.presliding_displacement < 0)
-    throw UsageError("--presliding-displacement: expected a value >= 0");
-  if (!(opt.false_alarms_per_hour > 0))
-    throw UsageError("--false-alarms-per-hour: expected a value > 0");
-  // The library's one fixed scale: v_s, or δ with the Dahl sign.
-  co.smoothing_velocity =
-      co.sign == SmoothSign::kDahl ? opt.presliding_displacement : opt.smoothing_velocity;
-  co.payload = opt.payload;
-  co.known_external_torque = opt.known_torque;
-  co.inertia_correction = opt.inertia;
-  co.false_alarms_per_hour = opt.false_alarms_per_hour;
-  const std::optional<ThresholdModel> thresholds = threshold_model(opt.thresholds);
-  if (!thresholds) {
-    throw UsageError("--thresholds: expected auto, constant or speed, got '" + opt.thresholds +
-                     "'");
+  try {
+    co = calibration_options(opt.arguments, kOptionSpelling);
+  } catch (const Error& e) {
+    throw UsageError(e.what());  // a bad option: exit code 2
   }
-  co.thresholds = *thresholds;
   LoadOptions load;
   load.package_path = opt.package_path;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   const auto start = std::chrono::steady_clock::now();
-  const CalibrateLogResult run = calibrate_log(config, opt.log, co, opt.holdout);
+  const CalibrateLogResult run = calibrate_log(config, opt.log, co, opt.arguments.holdout);
   const Calibration& cal = run.calibration;
   const HoldoutReport* holdout = run.holdout ? &*run.holdout : nullptr;
   const double seconds =
@@ -187,7 +167,7 @@ void run_calibrate(const CalibrateOptions& opt) {
   std::cout << "extwrench calibrate: " << run.rows << " rows, fit on " << run.fit_rows << " ("
             << cal.samples_used << " used) in " << cell(seconds, 0) << " s -> " << opt.out.string()
             << "\n";
-  print_report(cal, holdout, opt.known_torque);
+  print_report(cal, holdout, opt.arguments.known_torque);
 }
 
 }  // namespace
@@ -207,37 +187,37 @@ void register_calibrate(CLI::App& app) {
   sub->add_option("--out", opt->out, "Calibration file to write")
       ->required()
       ->type_name("CALIB.yaml");
-  sub->add_option("--holdout", opt->holdout,
+  sub->add_option("--holdout", opt->arguments.holdout,
                   "Fit on the first 1 - FRACTION of the log, report false alarms and detectable "
                   "forces on the rest (default 0)")
       ->type_name("FRACTION");
-  sub->add_option("--sign", opt->sign,
+  sub->add_option("--sign", opt->arguments.sign,
                   "Sign of the Coulomb term: tanh | sigmoid (of the velocity) | dahl (lags a "
                   "reversal by a presliding displacement; docs/calibration.md)")
       ->type_name("MODEL");
-  sub->add_option("--smoothing-velocity", opt->smoothing_velocity,
+  sub->add_option("--smoothing-velocity", opt->arguments.smoothing_velocity,
                   "Coulomb smoothing velocity [rad/s] (default: chosen per joint)")
       ->type_name("V");
-  sub->add_option("--presliding-displacement", opt->presliding_displacement,
+  sub->add_option("--presliding-displacement", opt->arguments.presliding_displacement,
                   "With --sign dahl: presliding displacement [rad] (default: chosen per joint "
                   "from 0.5 to 10 mrad)")
       ->type_name("D");
-  sub->add_option("--false-alarms-per-hour", opt->false_alarms_per_hour,
+  sub->add_option("--false-alarms-per-hour", opt->arguments.false_alarms_per_hour,
                   "False-alarm rate the thresholds are set for (default 1)")
       ->type_name("RATE");
-  sub->add_option("--thresholds", opt->thresholds,
+  sub->add_option("--thresholds", opt->arguments.thresholds,
                   "Joint thresholds: constant (a), speed (a + b|dq| on every joint) or auto "
                   "(a + b|dq| where it is lower on average over the motion; default)")
       ->type_name("FORM");
-  sub->add_flag("--payload", opt->payload,
+  sub->add_flag("--payload", opt->arguments.payload,
                 "Identify a payload (mass, CoM) on the last link from the base F/T sensor and add "
                 "it to the model (needs sensor.type: ft)");
-  sub->add_flag("--known-torque", opt->known_torque,
+  sub->add_flag("--known-torque", opt->arguments.known_torque,
                 "The log is not contact-free but its true_tau_ext1..n columns hold the external "
                 "torque known during the recording (e.g. J_v^T F of a force plate under the "
                 "contact): it is taken out of the residual before the fit (needs sensor.type: "
                 "none)");
-  sub->add_flag("--inertia", opt->inertia,
+  sub->add_flag("--inertia", opt->arguments.inertia,
                 "Also fit a correction of the inertia along each joint (observer.inertia_"
                 "correction), kept where it lowers the joint's residual by 10 % or more beyond a "
                 "gravity error; best with observer.residual_cutoff on noisy joints");

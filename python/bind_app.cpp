@@ -7,6 +7,7 @@
 #include <fstream>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "estimator.hpp"
@@ -49,42 +50,10 @@ py::list run_scenario_py(const std::filesystem::path& scenario_path,
   return out;
 }
 
-// The options of `extwrench calibrate` under their Python names, checked as the command checks
-// them (cli/calibrate.cpp).
-CalibrationOptions calibration_options(const std::string& sign, double smoothing_velocity,
-                                       double presliding_displacement, double false_alarms_per_hour,
-                                       const std::string& thresholds, bool payload,
-                                       bool known_torque, bool inertia) {
-  CalibrationOptions o;
-  const std::optional<SmoothSign> s = calibration_sign(sign);
-  if (!s) throw py::value_error("sign: expected 'tanh', 'sigmoid' or 'dahl', got '" + sign + "'");
-  o.sign = *s;
-  const std::optional<ThresholdModel> t = threshold_model(thresholds);
-  if (!t) {
-    throw py::value_error("thresholds: expected 'auto', 'constant' or 'speed', got '" + thresholds +
-                          "'");
-  }
-  o.thresholds = *t;
-  if (!(smoothing_velocity >= 0.0))
-    throw py::value_error("smoothing_velocity: expected a value >= 0 [rad/s]");
-  if (!(presliding_displacement >= 0.0))
-    throw py::value_error("presliding_displacement: expected a value >= 0 [rad]");
-  if (o.sign == SmoothSign::kDahl && smoothing_velocity > 0) {
-    throw py::value_error(
-        "smoothing_velocity: not used with sign='dahl' (its presliding displacement is chosen "
-        "per joint, or fixed by presliding_displacement)");
-  }
-  if (o.sign != SmoothSign::kDahl && presliding_displacement > 0)
-    throw py::value_error("presliding_displacement: only with sign='dahl'");
-  if (!(false_alarms_per_hour > 0.0))
-    throw py::value_error("false_alarms_per_hour: expected a value > 0");
-  o.smoothing_velocity = o.sign == SmoothSign::kDahl ? presliding_displacement : smoothing_velocity;
-  o.false_alarms_per_hour = false_alarms_per_hour;
-  o.payload = payload;
-  o.known_external_torque = known_torque;
-  o.inertia_correction = inertia;
-  return o;
-}
+// The calibrate keywords in messages: "smoothing_velocity: not used with sign='dahl'".
+std::string keyword_name(std::string_view key) { return std::string(key); }
+std::string keyword_value(std::string_view text) { return "'" + std::string(text) + "'"; }
+constexpr ArgumentSpelling kKeywordSpelling{keyword_name, keyword_value, "="};
 
 py::dict friction_dict(const JointFriction& f) {
   py::dict d;
@@ -161,9 +130,17 @@ py::dict calibrate_py(const Estimator& estimator, const std::filesystem::path& l
                       double presliding_displacement, double false_alarms_per_hour,
                       const std::string& thresholds, bool payload, bool known_torque, bool inertia,
                       const std::optional<std::filesystem::path>& out) {
-  const CalibrationOptions options =
-      calibration_options(sign, smoothing_velocity, presliding_displacement, false_alarms_per_hour,
-                          thresholds, payload, known_torque, inertia);
+  CalibrateArguments arguments;
+  arguments.holdout = holdout;
+  arguments.sign = sign;
+  arguments.smoothing_velocity = smoothing_velocity;
+  arguments.presliding_displacement = presliding_displacement;
+  arguments.false_alarms_per_hour = false_alarms_per_hour;
+  arguments.thresholds = thresholds;
+  arguments.payload = payload;
+  arguments.known_torque = known_torque;
+  arguments.inertia = inertia;
+  const CalibrationOptions options = calibration_options(arguments, kKeywordSpelling);
   CalibrateLogResult run;
   std::string yaml;
   {

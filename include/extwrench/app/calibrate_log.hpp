@@ -6,12 +6,44 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <string_view>
 
 #include "extwrench/calibration/calibration.hpp"
 #include "extwrench/calibration/holdout.hpp"
 #include "extwrench/io/estimator_config.hpp"
 
 namespace extwrench {
+
+/// A calibration's options as a user gives them: `extwrench calibrate`'s options, Python's
+/// calibrate keywords (docs/calibration.md).
+struct CalibrateArguments {
+  double holdout = 0.0;  ///< share of the log judged, not fitted, in [0, 1)
+  std::string sign = "tanh";
+  double smoothing_velocity = 0.0;       ///< v_s [rad/s], not with dahl; 0: per joint
+  double presliding_displacement = 0.0;  ///< δ [rad], dahl only; 0: per joint
+  double false_alarms_per_hour = 1.0;
+  std::string thresholds = "auto";
+  bool payload = false;
+  bool known_torque = false;
+  bool inertia = false;
+};
+
+/// How a front end spells its arguments in messages: an argument's name from its key
+/// ("smoothing_velocity" -> "--smoothing-velocity"), a value ("dahl" -> "'dahl'"), and what joins
+/// a name to its value ("--sign dahl", "sign='dahl'").
+struct ArgumentSpelling {
+  std::string (*name)(std::string_view key);
+  std::string (*value)(std::string_view text);
+  std::string_view assign;
+};
+
+/// The CalibrationOptions of checked arguments. Throws extwrench::Error "NAME: what" for the
+/// first bad one: a holdout outside [0, 1), an unknown sign or threshold form, a negative (or
+/// NaN) smoothing velocity or presliding displacement, either one with the other sign, a
+/// false-alarm rate not > 0.
+[[nodiscard]] CalibrationOptions calibration_options(const CalibrateArguments& arguments,
+                                                     const ArgumentSpelling& spelling);
 
 struct CalibrateLogResult {
   std::size_t rows = 0;                  ///< samples in the log
