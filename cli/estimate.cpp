@@ -102,26 +102,6 @@ std::vector<std::filesystem::path> output_dirs(const LogInputs& in,
   return dirs;
 }
 
-// "contact: 586 of 4001 samples (14.6 %), 2 episodes; link4 223, link5 5, link6 354": the
-// estimates at a glance, with or without truth (links in body order, those never declared left
-// out).
-std::string contact_summary(const ReplayResult& r, const Model& model) {
-  char head[128];
-  std::snprintf(
-      head, sizeof head, "contact: %ld of %ld samples (%.1f %%), %ld episode%s", r.contact_samples,
-      r.rows,
-      100.0 * static_cast<double>(r.contact_samples) / static_cast<double>(std::max(r.rows, 1L)),
-      r.contact_episodes, r.contact_episodes == 1 ? "" : "s");
-  std::string text = head;
-  const char* sep = "; ";
-  for (std::size_t l = 0; l < r.contact_samples_by_link.size(); ++l) {
-    if (r.contact_samples_by_link[l] == 0) continue;
-    text += sep + model.bodies[l].name + " " + std::to_string(r.contact_samples_by_link[l]);
-    sep = ", ";
-  }
-  return text;
-}
-
 // One log's replay; what it prints goes to `console` (a buffer when jobs run in parallel).
 void estimate_log(const EstimatorConfig& config, ReplayOptions replay,
                   const std::string& description, std::ostream& console) {
@@ -129,7 +109,7 @@ void estimate_log(const EstimatorConfig& config, ReplayOptions replay,
       replay_log(config.robot.model, config.robot.geometry, config.options, replay);
   console << "extwrench estimate: " << r.rows << " rows -> "
           << (replay.out_dir / "estimates.csv").string() << "\n";
-  console << "  " << contact_summary(r, config.robot.model) << "\n";
+  console << "  " << contact_summary(r.contacts, config.robot.model) << "\n";
   if (r.has_truth) {
     const sim::Metrics& m = r.report.windows.front().metrics;
     console << "  metrics (" << description << "), as in `extwrench simulate`:\n"

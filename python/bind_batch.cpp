@@ -7,6 +7,7 @@
 
 #include "arrays.hpp"
 #include "estimator.hpp"
+#include "extwrench/app/contact_tally.hpp"
 
 namespace extwrench::python {
 namespace {
@@ -259,9 +260,61 @@ py::dict estimate_batch(const Estimator& source, const py::handle& t, const py::
   return d;
 }
 
+/// `a` as a 1-D array of `rows` entries of type T (numpy converts what it can: a TypeError
+/// otherwise); ValueError naming `name` for another shape.
+template <typename T>
+py::array_t<T, py::array::forcecast> column_of(const py::handle& a, const char* name,
+                                               py::ssize_t rows) {
+  py::array_t<T, py::array::forcecast> column(py::reinterpret_borrow<py::object>(a));
+  if (column.ndim() != 1 || column.shape(0) != rows) {
+    throw py::value_error(std::string(name) + ": expected shape " + shape_text(rows) + ", got " +
+                          (column.ndim() == 1 ? shape_text(column.shape(0))
+                                              : std::to_string(column.ndim()) + " dimensions"));
+  }
+  return column;
+}
+
+/// The tally of `extwrench estimate`'s contact line and notes (app/contact_tally.hpp) over the
+/// columns of estimate()'s dict.
+py::dict contact_summary_py(const Estimator& source, const py::handle& t, const py::handle& contact,
+                            const py::handle& link, const py::handle& flags) {
+  const RealArray time = real_array(t, "t", 1);
+  check_finite(time, "t");
+  const py::ssize_t rows = time.rows;
+  const auto on = column_of<bool>(contact, "contact", rows);
+  const auto body = column_of<std::int32_t>(link, "link", rows);
+  const bool has_flags = !flags.is_none();
+  py::array_t<std::uint32_t, py::array::forcecast> bits;
+  if (has_flags) bits = column_of<std::uint32_t>(flags, "flags", rows);
+  const Model& model = source.config.robot.model;
+  ContactTally tally(model.num_bodies());
+  const auto disagreement = static_cast<std::uint32_t>(EstimateFlag::kDisagreement);
+  for (py::ssize_t k = 0; k < rows; ++k) {
+    tally.add(time.at(k), on.at(k), body.at(k), has_flags && (bits.at(k) & disagreement) != 0);
+  }
+  py::dict by_link;
+  for (std::size_t l = 0; l < tally.samples_by_link.size(); ++l) {
+    if (tally.samples_by_link[l] > 0)
+      by_link[py::str(model.bodies[l].name)] = tally.samples_by_link[l];
+  }
+  py::dict d;
+  d["samples"] = tally.rows;
+  d["contact_samples"] = tally.contact_samples;
+  d["episodes"] = tally.contact_episodes;
+  d["disagreement_samples"] = tally.disagreement_samples;
+  d["by_link"] = by_link;
+  d["duration"] = tally.duration();
+  d["text"] = contact_summary(tally, model);
+  d["note"] = frequent_alarms_note(tally);
+  d["disagreement_warning"] = disagreement_warning(tally);
+  return d;
+}
+
 void bind_batch(py::module_& m) {
   m.def("_estimate", &estimate_batch, py::arg("estimator"), py::arg("t"), py::arg("q"),
         py::arg("dq"), py::arg("tau"), py::arg("reading") = py::none());
+  m.def("_contact_summary", &contact_summary_py, py::arg("estimator"), py::arg("t"),
+        py::arg("contact"), py::arg("link"), py::arg("flags") = py::none());
 }
 
 }  // namespace extwrench::python

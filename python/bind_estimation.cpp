@@ -271,6 +271,13 @@ Returns an Estimate. Bad input raises ValueError naming it; the state is then un
           "sensor_type",
           [](const Estimator& e) { return std::string(to_string(e.config.options.sensor.type)); })
       .def_property_readonly("robot_path", [](const Estimator& e) { return e.config.robot_path; })
+      .def_property_readonly(
+          "calibration_path",
+          [](const Estimator& e) -> py::object {
+            if (e.config.calibration_path.empty()) return py::none();
+            return py::cast(e.config.calibration_path);
+          },
+          "The calibration file the configuration includes (`calibration:`), or None.")
       .def(
           "config_yaml",
           [](const Estimator& e) { return to_yaml(e.config, std::filesystem::current_path()); },

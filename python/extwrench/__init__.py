@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+import warnings
 from typing import Any, Dict, List, Optional, Union
 
 import numpy as np
@@ -44,12 +45,20 @@ gravity_torques = gravity
 
 __all__ = [
     "ContactEstimator", "Error", "Estimate", "ExternalWrench", "Robot", "__version__", "bias",
-    "bias_torques", "calibrate", "coriolis_matrix", "crba", "estimate", "forward_dynamics",
+    "EstimateWarning", "bias_torques", "calibrate", "contact_summary", "coriolis_matrix", "crba",
+    "estimate", "forward_dynamics",
     "forward_kinematics", "gravity", "gravity_torques", "jacobian", "load_robot", "metrics",
     "read_log", "rnea", "sensor_reading", "simulate", "write_estimates",
 ]
 
 _AXES = ("x", "y", "z")
+
+
+class EstimateWarning(UserWarning):
+    """What `extwrench estimate` writes to stderr after a replay, for estimate()'s arrays: contacts
+    that look like the model's error (a note to calibrate, for configurations without one), or
+    contact samples that mostly carry 'disagreement' (docs/python.md). Silence it with
+    ``warnings.simplefilter("ignore", extwrench.EstimateWarning)``."""
 
 
 def _estimator_for(source: Any, reading: Any) -> ContactEstimator:
@@ -66,7 +75,8 @@ def _estimator_for(source: Any, reading: Any) -> ContactEstimator:
 
 
 def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.PathLike],
-             t: Any, q: Any, dq: Any, tau: Any, reading: Any = None) -> Dict[str, np.ndarray]:
+             t: Any, q: Any, dq: Any, tau: Any, reading: Any = None, *,
+             notes: bool = True) -> Dict[str, np.ndarray]:
     """Runs a whole log through a fresh estimator (the loop is C++, the GIL released).
 
     source: a ContactEstimator (its configuration; the object itself is not changed), a
@@ -79,9 +89,20 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
     fx fy fz, mx my mz, px py pz, lx ly lz (views of force_W, moment_W, point_W,
     line_point_W, each (N, 3), world frame), status (str), cond, r1..rn (views of residual
     (N, n)); besides: flags (uint32 bits), point_L, line_direction_W (N, 3), surface_distance.
+    With notes, what `extwrench estimate` notes on stderr is an EstimateWarning: contacts that
+    look like the model's error (when the configuration includes no calibration), or mostly
+    flagged 'disagreement'. contact_summary() gives the counts.
     """
     est = _estimator_for(source, reading)
     out = _extwrench._estimate(est, t, q, dq, tau, reading)
+    if notes:
+        summary = _extwrench._contact_summary(est, out["t"], out["contact"], out["link"],
+                                              out["flags"])
+        if summary["disagreement_warning"]:
+            warnings.warn(summary["disagreement_warning"], EstimateWarning, stacklevel=2)
+        if summary["note"] and est.calibration_path is None:
+            warnings.warn(summary["note"] + "; in Python: extwrench.calibrate(estimator, "
+                          "'FREE.csv', out='CALIB.yaml')", EstimateWarning, stacklevel=2)
     # An object array of the few distinct texts: 8 bytes a row, not a fixed-width string each.
     names = np.empty(len(out["status_names"]), dtype=object)
     names[:] = out.pop("status_names")
@@ -93,6 +114,23 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
     for i in range(out["residual"].shape[1]):
         out["r%d" % (i + 1)] = out["residual"][:, i]
     return out
+
+
+def contact_summary(estimates: Dict[str, Any],
+                    source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.PathLike]
+                    ) -> Dict[str, Any]:
+    """The estimates at a glance, as `extwrench estimate` prints them after a replay.
+
+    estimates: estimate()'s dict (or any dict with its t, contact, link and optionally flags).
+    source: what names the links (a ContactEstimator, Robot, configuration dict or file).
+    Returns samples, contact_samples, episodes (contacts declared anew), disagreement_samples,
+    by_link {link name: contact samples}, duration [s], text (the command's line "contact: ..."),
+    note (the note to calibrate when the contacts look like the model's error, else "") and
+    disagreement_warning (else "").
+    """
+    est = _estimator_for(source, None)
+    return _extwrench._contact_summary(est, estimates["t"], estimates["contact"],
+                                       estimates["link"], estimates.get("flags"))
 
 
 def simulate(scenario: Union[str, os.PathLike], out_dir: Optional[Union[str, os.PathLike]] = None,
@@ -115,6 +153,7 @@ def simulate(scenario: Union[str, os.PathLike], out_dir: Optional[Union[str, os.
             if "log" not in run:
                 run["log"] = read_log(log_path, est)
             log = run["log"]
+            # The scenario's replay already printed its warnings; the logs carry truth.
             run["estimates"][scheme] = estimate(est, log["t"], log["q"], log["dq"], log["tau"],
-                                                log.get("reading"))
+                                                log.get("reading"), notes=False)
     return runs

@@ -30,9 +30,15 @@ from ._extwrench import (
 bias_torques = bias
 gravity_torques = gravity
 
+class EstimateWarning(UserWarning): ...
+
 def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.PathLike],
              t: npt.ArrayLike, q: npt.ArrayLike, dq: Optional[npt.ArrayLike],
-             tau: npt.ArrayLike, reading: Optional[npt.ArrayLike] = ...) -> Dict[str, np.ndarray]: ...
+             tau: npt.ArrayLike, reading: Optional[npt.ArrayLike] = ..., *,
+             notes: bool = ...) -> Dict[str, np.ndarray]: ...
+def contact_summary(estimates: Dict[str, Any],
+                    source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.PathLike]
+                    ) -> Dict[str, Any]: ...
 def simulate(scenario: Union[str, os.PathLike],
              out_dir: Optional[Union[str, os.PathLike]] = ..., figures: bool = ...,
              package_path: Optional[List[str]] = ...) -> List[Dict[str, Any]]: ...

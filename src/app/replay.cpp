@@ -194,52 +194,6 @@ void draw_figures(const detail::FigureRecorder& figures, const Model& model,
 
 }  // namespace
 
-std::string disagreement_warning(const ReplayResult& r) {
-  // A few flagged samples happen at contact edges; a majority over a real contact does not.
-  constexpr long kMinContactSamples = 20;
-  if (r.contact_samples < kMinContactSamples || 2 * r.disagreement_samples <= r.contact_samples)
-    return {};
-  char pct[32];
-  std::snprintf(pct, sizeof pct, "%.0f %%", 100.0 * r.disagreement_fraction());
-  return std::string(pct) + " of the " + std::to_string(r.contact_samples) +
-         " contact samples carry 'disagreement' (the base sensor and the joint residual do not "
-         "agree): check the sensor pose (sensor.pose, or the model's 'sensor' frame), the robot "
-         "model (masses, inertias, joint order) and the sensor's calibration (bias: sensor.tare)";
-}
-
-std::string frequent_alarms_note(const ReplayResult& r) {
-  // A model error false-alarms in either of two ways (the real Panda uncalibrated: 35-45
-  // episodes in 10.5 s; the paper arm with unmodelled friction: 99 % of the samples, 1-3 episodes,
-  // on 3-5 links as the motion moves the error between joints). A real contact is declared once
-  // and stays on its link.
-  constexpr long kMinEpisodes = 10;
-  constexpr double kMinEpisodesPerSecond = 1.0;
-  constexpr double kMostSamples = 0.5;
-  constexpr double kLinkShare = 0.02;  // of the contact samples, for a link to count
-  constexpr int kMinLinks = 3;
-  if (r.has_truth || r.rows == 0 || r.contact_samples == 0) return {};
-  const double duration = r.report.t_end - r.report.t_begin;
-  const double share = static_cast<double>(r.contact_samples) / static_cast<double>(r.rows);
-  int links = 0;
-  for (const long count : r.contact_samples_by_link)
-    if (static_cast<double>(count) >= kLinkShare * static_cast<double>(r.contact_samples)) ++links;
-  const bool frequent = r.contact_episodes >= kMinEpisodes &&
-                        static_cast<double>(r.contact_episodes) >= kMinEpisodesPerSecond * duration;
-  const bool wandering = share >= kMostSamples && links >= kMinLinks;
-  if (!frequent && !wandering) return {};
-  char text[160];
-  std::snprintf(text, sizeof text,
-                "contact declared on %.0f %% of the samples, %ld time%s in %.1f s, on %d links",
-                100.0 * share, r.contact_episodes, r.contact_episodes == 1 ? "" : "s", duration,
-                links);
-  return std::string(text) +
-         ": what a robot moving freely shows when its thresholds lie below what its model misses "
-         "(friction, torque offsets, noise). If nothing touched the robot, calibrate on a "
-         "contact-free log and include the result (`extwrench calibrate --config CONFIG.yaml "
-         "--log FREE.csv --out CALIB.yaml`, then `calibration: CALIB.yaml` in the "
-         "configuration; docs/calibration.md)";
-}
-
 ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator_options, const ReplayOptions& o) {
   LogReader reader(o.log, model);
@@ -262,9 +216,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   const std::string title = title_of(o);
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
   LogSpan span;
-  long contact_samples = 0, disagreement_samples = 0, contact_episodes = 0;
-  std::vector<long> contact_by_link(static_cast<std::size_t>(model.nq()) + 1, 0);
-  bool in_contact = false;
+  ContactTally contacts(model.num_bodies());
   const std::string log_name = reader.name();  // the reader belongs to its thread from here on
   detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype());
   while (const Sample* sample = pipeline.next()) {
@@ -272,12 +224,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     const ContactEstimate& e = estimator.update(s);
     pipeline.push(e);
     span.add(s.t);
-    contact_samples += e.contact ? 1 : 0;
-    disagreement_samples += e.contact && e.has(EstimateFlag::kDisagreement) ? 1 : 0;
-    if (e.contact && !in_contact) ++contact_episodes;
-    in_contact = e.contact;
-    if (e.contact && e.link >= 0 && e.link <= model.nq())
-      ++contact_by_link[static_cast<std::size_t>(e.link)];
+    contacts.add(s.t, e.contact, e.link, e.has(EstimateFlag::kDisagreement));
     if (layout.truth) metrics.add(s, e);
     if (figures) figures->add(s, e, estimator.detector());
     progress.update(span.rows, "%s: replayed %ld rows (t = %.1f s)", title.c_str(), span.rows, s.t);
@@ -292,10 +239,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   result.rows = span.rows;
   result.has_truth = layout.truth;
   result.report = report_of(o, span);
-  result.contact_samples = contact_samples;
-  result.disagreement_samples = disagreement_samples;
-  result.contact_episodes = contact_episodes;
-  result.contact_samples_by_link = std::move(contact_by_link);
+  result.contacts = std::move(contacts);
   if (layout.truth) {
     result.report.windows = metrics.result();
     const std::filesystem::path json = o.out_dir / "metrics.json";
@@ -304,12 +248,12 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   }
   if (o.figures) draw_figures(*figures, model, geometry, estimator_options, o, outputs, result);
   if (o.warn_disagreement) {
-    const std::string warning = disagreement_warning(result);
+    const std::string warning = disagreement_warning(result.contacts);
     if (!warning.empty())
       messages_of(o) << "extwrench: warning: " << title << ": " << warning << "\n";
   }
-  if (o.note_frequent_alarms) {
-    const std::string note = frequent_alarms_note(result);
+  if (o.note_frequent_alarms && !result.has_truth) {
+    const std::string note = frequent_alarms_note(result.contacts);
     if (!note.empty()) messages_of(o) << "extwrench: note: " << title << ": " << note << "\n";
   }
   own_outputs.keep();

@@ -624,22 +624,35 @@ TEST_F(Replay, LongLogReplaysInTheMemoryOfAShortOne) {
 // The note of a log without truth whose contacts look like the model's error (docs/cli.md): the
 // real Panda's uncalibrated free motion (3623 of 9752 samples, 42 episodes in 10.5 s, 4 links with
 // 2 % of them; measured with `estimate`, K = 50) and the paper arm's unmodelled friction (99 % of
-// the samples, 1-3 episodes, on 3-5 links) get it; one long push on one link, a few pushes an hour
-// and any log with truth do not.
+// the samples, 1-3 episodes, on 3-5 links) get it; one long push on one link and a few pushes an
+// hour do not (replay_log asks for it only for logs without truth).
 TEST(FrequentAlarmsNote, SaysCalibrateOnlyForTheModelErrorsPatterns) {
+  // A tally of `rows` samples over `seconds`: `episodes` contacts of equal length, their samples
+  // shared among the links as `by_link` says.
   const auto result = [](long rows, long contact, long episodes, double seconds,
-                         std::vector<long> by_link, bool truth = false) {
-    ReplayResult r;
-    r.rows = rows;
-    r.contact_samples = contact;
-    r.contact_episodes = episodes;
-    r.report.t_begin = 0.0;
-    r.report.t_end = seconds;
-    r.contact_samples_by_link = std::move(by_link);
-    r.has_truth = truth;
-    return r;
+                         std::vector<long> by_link) {
+    ContactTally tally(static_cast<int>(by_link.size()));
+    std::vector<int> links;
+    for (std::size_t l = 0; l < by_link.size(); ++l)
+      links.insert(links.end(), static_cast<std::size_t>(by_link[l]), static_cast<int>(l));
+    EXPECT_EQ(static_cast<long>(links.size()), contact);
+    // Episode e starts at e * period and holds contact / episodes samples (one more for the
+    // first contact % episodes of them); free samples up to the next one.
+    const long period = rows / episodes;
+    std::size_t next = 0;
+    for (long k = 0; k < rows; ++k) {
+      const long e = k / period;
+      const bool on =
+          e < episodes && k % period < contact / episodes + (e < contact % episodes ? 1 : 0);
+      tally.add(seconds * static_cast<double>(k) / static_cast<double>(rows - 1), on,
+                on ? links.at(next++) : -1, false);
+    }
+    EXPECT_EQ(tally.contact_samples, contact);
+    EXPECT_EQ(tally.contact_episodes, episodes);
+    EXPECT_EQ(tally.samples_by_link, by_link);
+    return tally;
   };
-  const ReplayResult panda = result(9752, 3623, 42, 10.5, {0, 0, 1445, 54, 1128, 0, 329, 667});
+  const ContactTally panda = result(9752, 3623, 42, 10.5, {0, 0, 1445, 54, 1128, 0, 329, 667});
   const std::string note = frequent_alarms_note(panda);
   EXPECT_NE(note.find("contact declared on 37 % of the samples, 42 times in 10.5 s, on 4 links"),
             std::string::npos)
@@ -655,11 +668,49 @@ TEST(FrequentAlarmsNote, SaysCalibrateOnlyForTheModelErrorsPatterns) {
   EXPECT_EQ(frequent_alarms_note(
                 result(3600000, 30000, 30, 3600.0, {0, 0, 0, 10000, 10000, 10000, 0, 0})),
             "");
-  // Nine quick alarms, and the same log with truth (a simulation: its metrics say it all).
+  // Nine quick alarms.
   EXPECT_EQ(frequent_alarms_note(result(9752, 300, 9, 10.5, {0, 100, 100, 100, 0, 0, 0, 0})), "");
-  EXPECT_EQ(
-      frequent_alarms_note(result(9752, 3623, 42, 10.5, {0, 0, 1445, 54, 1128, 0, 329, 667}, true)),
-      "");
+}
+
+// The tally behind `estimate`'s line, by hand: a contact on the first sample is an episode, a
+// contact declared without a link counts towards the samples but no link, `disagreement` counts
+// only on contact samples.
+TEST(ContactTally, CountsSamplesEpisodesAndLinksAsTheLineSays) {
+  Model model;
+  for (const char* name : {"base", "upper", "lower"}) {
+    Body body;
+    body.name = name;
+    model.bodies.push_back(body);
+  }
+  ContactTally tally(model.num_bodies());
+  // t, contact, link, disagreement
+  const struct {
+    double t;
+    bool contact;
+    int link;
+    bool disagreement;
+  } rows[] = {{0.5, true, 2, false},   {0.6, true, 2, true},  {0.7, false, -1, true},
+              {0.8, false, -1, false}, {0.9, true, 1, true},  {1.0, true, -1, false},
+              {1.1, false, -1, false}, {1.2, true, 7, false}, {1.3, true, 2, false}};
+  for (const auto& r : rows) tally.add(r.t, r.contact, r.link, r.disagreement);
+  EXPECT_EQ(tally.rows, 9);
+  EXPECT_EQ(tally.contact_samples, 6);
+  EXPECT_EQ(tally.contact_episodes, 3);
+  EXPECT_EQ(tally.disagreement_samples, 2);
+  EXPECT_EQ(tally.samples_by_link, (std::vector<long>{0, 1, 3}));
+  EXPECT_DOUBLE_EQ(tally.duration(), 0.8);
+  EXPECT_DOUBLE_EQ(tally.disagreement_fraction(), 2.0 / 6.0);
+  EXPECT_EQ(contact_summary(tally, model),
+            "contact: 6 of 9 samples (66.7 %), 3 episodes; upper 1, lower 3");
+  EXPECT_EQ(contact_summary(ContactTally(model.num_bodies()), model),
+            "contact: 0 of 0 samples (0.0 %), 0 episodes");
+  // Too few contact samples for the sensor warning; 20 of which 11 disagree: warned.
+  EXPECT_EQ(disagreement_warning(tally), "");
+  ContactTally doubtful(model.num_bodies());
+  for (int k = 0; k < 20; ++k) doubtful.add(0.001 * k, true, 2, k < 11);
+  EXPECT_NE(disagreement_warning(doubtful).find("55 % of the 20 contact samples"),
+            std::string::npos)
+      << disagreement_warning(doubtful);
 }
 
 }  // namespace

@@ -499,7 +499,7 @@ TEST_F(MujocoCollisions, PandaCalibratedOnAFreeRunUnderEncoderQuantisation) {
         r.figures = false;
         r.messages = &messages;
         disagreement =
-            replay_log(cfg.robot.model, cfg.robot.geometry, options, r).disagreement_fraction();
+            replay_log(cfg.robot.model, cfg.robot.geometry, options, r).contacts.disagreement_fraction();
         return measure(r.log, r.out_dir / "estimates.csv");
       };
       const Figures defaults = measure(dir / "log.csv", dir / scheme / "estimates.csv");

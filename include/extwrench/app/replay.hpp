@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "extwrench/app/contact_tally.hpp"
 #include "extwrench/app/gnuplot.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/metrics_json.hpp"
@@ -62,29 +63,9 @@ struct ReplayResult {
   MetricsReport report;  ///< empty windows without truth
   std::vector<std::filesystem::path> figures;
   std::vector<std::string> figure_failures;  ///< one per figure not drawn (warned on stderr)
-  long contact_samples = 0;                  ///< estimates with a contact declared
-  long disagreement_samples = 0;             ///< of those, flagged `disagreement`
-  long contact_episodes = 0;  ///< contacts declared anew (a contact sample after a free one)
-  /// Contact samples by the estimate's link, index 0..n (0: link 0, seen by the base sensor only).
-  std::vector<long> contact_samples_by_link;
-  /// disagreement_samples / contact_samples (0 without contact).
-  [[nodiscard]] double disagreement_fraction() const {
-    return contact_samples > 0
-               ? static_cast<double>(disagreement_samples) / static_cast<double>(contact_samples)
-               : 0.0;
-  }
+  /// The estimates at a glance: contact samples, episodes, samples per link (contact_tally.hpp).
+  ContactTally contacts;
 };
-
-/// The run-level warning of a replay whose contact samples mostly carry `disagreement` (the
-/// base sensor and the joint residual tell different stories), naming the likely causes; empty
-/// when there is nothing to warn about (fewer than half, or too few contact samples).
-[[nodiscard]] std::string disagreement_warning(const ReplayResult& result);
-
-/// The note for a log without truth whose contacts look like a model's error rather than a
-/// touch: declared anew at least once a second (10 times or more), or on most samples spread over
-/// three links or more (each with 2 % of the contact samples); with the remedy (calibrate on a
-/// contact-free log, docs/calibration.md). Empty otherwise, and for logs with truth.
-[[nodiscard]] std::string frequent_alarms_note(const ReplayResult& result);
 
 /// Reads `options.log` row by row, runs a ContactEstimator built from (model, geometry,
 /// estimator) on it, writes out_dir/estimates.csv, and with truth columns out_dir/metrics.json;

@@ -1,0 +1,57 @@
+// What a replay's estimates look like at a glance: how many samples declare a contact, how often
+// a contact starts, on which links. `extwrench estimate` prints it per log, and its two rules tell
+// a model's error (false alarms all over the motion) and a doubtful sensor apart from a touch; the
+// Python `estimate` applies the same rules to its arrays.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "extwrench/model/model.hpp"
+
+namespace extwrench {
+
+struct ContactTally {
+  long rows = 0;
+  long contact_samples = 0;       ///< estimates with a contact declared
+  long disagreement_samples = 0;  ///< of those, flagged `disagreement`
+  long contact_episodes = 0;      ///< contacts declared anew (a contact sample after a free one)
+  /// Contact samples by the estimate's link, index 0..n (0: link 0, seen by the base sensor only).
+  std::vector<long> samples_by_link;
+  double t_begin = 0.0;  ///< the first and last sample's time [s]
+  double t_end = 0.0;
+
+  ContactTally() = default;
+  /// For a robot of `bodies` bodies (Model::num_bodies(), n + 1).
+  explicit ContactTally(int bodies);
+
+  /// One estimate: its time, whether it declares a contact, its link (counted when 0 <= link <
+  /// bodies) and whether it carries `disagreement`.
+  void add(double t, bool contact, int link, bool disagreement);
+
+  [[nodiscard]] double duration() const { return t_end - t_begin; }
+  /// disagreement_samples / contact_samples (0 without contact).
+  [[nodiscard]] double disagreement_fraction() const;
+
+ private:
+  bool in_contact_ = false;
+};
+
+/// "contact: 586 of 4001 samples (14.6 %), 2 episodes; link4 223, link5 5, link6 354": links in
+/// body order, those never declared left out.
+[[nodiscard]] std::string contact_summary(const ContactTally& tally, const Model& model);
+
+/// The warning for estimates whose contact samples mostly carry `disagreement` (the base sensor
+/// and the joint residual tell different stories), naming the likely causes; empty when there is
+/// nothing to warn about (fewer than half, or too few contact samples).
+[[nodiscard]] std::string disagreement_warning(const ContactTally& tally);
+
+/// The note for estimates whose contacts look like a model's error rather than a touch: declared
+/// anew at least once a second (10 times or more), or on most samples spread over three links or
+/// more (each with 2 % of the contact samples); with the remedy (calibrate on a contact-free log,
+/// docs/calibration.md). Empty otherwise. Meant for logs without truth and configurations without
+/// a calibration: the caller decides.
+[[nodiscard]] std::string frequent_alarms_note(const ContactTally& tally);
+
+}  // namespace extwrench

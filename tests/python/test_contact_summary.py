@@ -1,0 +1,122 @@
+"""extwrench.contact_summary and estimate()'s EstimateWarning: the line and the notes of
+`extwrench estimate` for estimate()'s arrays. The counts are checked against numpy, the text and
+the notes against what the command prints for the same log; the real Panda's contact-free log
+(../shared/realdata, skipped when absent) is the case the note is for."""
+
+import subprocess
+import warnings
+
+import numpy as np
+import pytest
+
+import extwrench
+from conftest import SOURCE_DIR
+
+PANDA = SOURCE_DIR.parent / "shared" / "realdata" / "franka_panda_free_motion"
+
+
+def numpy_counts(out, bodies):
+    contact = np.asarray(out["contact"], dtype=bool)
+    starts = contact & ~np.concatenate(([False], contact[:-1]))
+    links = out["link"][contact]
+    return {
+        "samples": len(contact),
+        "contact_samples": int(contact.sum()),
+        "episodes": int(starts.sum()),
+        "by_link": {bodies[l]: int((links == l).sum()) for l in np.unique(links)},
+    }
+
+
+def cli_lines(cli, cwd, args):
+    run = subprocess.run([cli] + args, cwd=cwd, capture_output=True, text=True, check=True)
+    return run.stdout, run.stderr
+
+
+@pytest.fixture(scope="module")
+def panda(tmp_path_factory):
+    if not (PANDA / "log.csv").exists():
+        pytest.skip("../shared/realdata is absent")
+    tmp = tmp_path_factory.mktemp("panda")
+    # The README's real-arm configuration without a calibration (K = 50, filter on joints 1-4).
+    config = ("robot: %s\nsensor: {type: none}\n"
+              "observer: {gain: 50, residual_cutoff: [20, 20, 20, 20, 0, 0, 0]}\n"
+              % (PANDA / "panda.urdf"))
+    (tmp / "panda.yaml").write_text(config)
+    est = extwrench.ContactEstimator(None, tmp / "panda.yaml")
+    log = extwrench.read_log(PANDA / "log.csv", est)
+    return {"dir": tmp, "config": config, "est": est, "log": log}
+
+
+def estimate(est, log, **kwargs):
+    return extwrench.estimate(est, log["t"], log["q"], log["dq"], log["tau"], log.get("reading"),
+                              **kwargs)
+
+
+def test_the_uncalibrated_real_panda_gets_the_commands_line_and_note(panda, cli):
+    est, log = panda["est"], panda["log"]
+    assert est.calibration_path is None
+    with pytest.warns(extwrench.EstimateWarning, match="contact declared on") as caught:
+        out = estimate(est, log)
+    assert len(caught) == 1
+    note = str(caught[0].message)
+    assert "extwrench calibrate" in note and caught[0].filename == __file__
+    summary = extwrench.contact_summary(out, est)
+    counts = numpy_counts(out, est.bodies)
+    assert {k: summary[k] for k in counts} == counts
+    assert summary["episodes"] >= 10 and note.startswith(summary["note"] + "; in Python: ")
+    assert summary["duration"] == pytest.approx(log["t"][-1] - log["t"][0])
+    # The command on the same file: the same line on stdout, the same note on stderr.
+    stdout, stderr = cli_lines(cli, panda["dir"], [
+        "estimate", "--no-figures", "--config", "panda.yaml", "--log", str(PANDA / "log.csv"),
+        "--out", "plain"])
+    assert "  " + summary["text"] + "\n" in stdout, stdout
+    assert "extwrench: note: panda: " + summary["note"] + "\n" in stderr, stderr
+    # Asked not to, estimate() stays silent and returns the same arrays.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        quiet = estimate(est, log, notes=False)
+    np.testing.assert_array_equal(quiet["residual"], out["residual"])
+
+
+def test_a_calibrated_configuration_gets_no_note(panda):
+    tmp = panda["dir"]
+    extwrench.calibrate(panda["est"], PANDA / "log.csv", out=tmp / "calib.yaml")
+    (tmp / "calibrated.yaml").write_text(panda["config"] + "calibration: calib.yaml\n")
+    est = extwrench.ContactEstimator(None, tmp / "calibrated.yaml")
+    assert est.calibration_path is not None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = estimate(est, panda["log"])
+    assert extwrench.contact_summary(out, est)["contact_samples"] == 0
+
+
+def test_the_paper_push_gets_its_line_and_no_note(paper_run, cli):
+    """One push held on one link: the command's line, numpy's counts, no warning."""
+    run = paper_run["dir"]
+    config = run / "ft" / "config.yaml"
+    est = extwrench.ContactEstimator(None, config)
+    log = extwrench.read_log(run / "log.csv", est)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = estimate(est, log)
+    summary = extwrench.contact_summary(out, est)
+    counts = numpy_counts(out, est.bodies)
+    assert {k: summary[k] for k in counts} == counts
+    assert summary["contact_samples"] > 0 and summary["note"] == ""
+    assert summary["disagreement_warning"] == ""
+    stdout, _ = cli_lines(cli, run, ["estimate", "--no-figures", "--config", str(config), "--log",
+                                     str(run / "log.csv"), "--out", str(run / "again")])
+    assert "  " + summary["text"] + "\n" in stdout, stdout
+
+
+def test_bad_columns_are_named(robot):
+    est = extwrench.ContactEstimator(robot, {"sensor": {"type": "none"}})
+    t = np.arange(5) * 1e-3
+    good = {"t": t, "contact": np.zeros(5, bool), "link": np.full(5, -1)}
+    assert extwrench.contact_summary(good, est)["samples"] == 5
+    with pytest.raises(ValueError, match="link: expected shape"):
+        extwrench.contact_summary(dict(good, link=np.zeros(4)), est)
+    with pytest.raises(ValueError, match=r"t\[2\] is nan"):
+        extwrench.contact_summary(dict(good, t=np.array([0, 1, np.nan, 3, 4.0])), est)
+    with pytest.raises(KeyError):
+        extwrench.contact_summary({"t": t}, est)
