@@ -4,7 +4,6 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <memory>
@@ -15,7 +14,6 @@
 #include "commands.hpp"
 #include "extwrench/app/calibrate_log.hpp"
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/calibration_file.hpp"
 #include "extwrench/io/estimator_config.hpp"
 
 namespace extwrench::cli {
@@ -160,10 +158,7 @@ void run_calibrate(const CalibrateOptions& opt) {
   const HoldoutReport* holdout = run.holdout ? &*run.holdout : nullptr;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::ofstream out(opt.out);
-  if (!out) throw Error(opt.out.string() + ": cannot write");
-  out << calibration_to_yaml(cal, holdout);
-  if (!out) throw Error(opt.out.string() + ": write failed");
+  write_calibration(opt.out, calibration_yaml(run));
   std::cout << "extwrench calibrate: " << run.rows << " rows, fit on " << run.fit_rows << " ("
             << cal.samples_used << " used) in " << cell(seconds, 0) << " s -> " << opt.out.string()
             << "\n";

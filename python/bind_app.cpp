@@ -4,7 +4,6 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
-#include <fstream>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -14,7 +13,6 @@
 #include "extwrench/app/calibrate_log.hpp"
 #include "extwrench/app/scenario_run.hpp"
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/calibration_file.hpp"
 #include "robot.hpp"
 
 namespace extwrench::python {
@@ -146,14 +144,9 @@ py::dict calibrate_py(const Estimator& estimator, const std::filesystem::path& l
   {
     py::gil_scoped_release release;
     run = calibrate_log(estimator.config, log, options, holdout);
-    yaml = calibration_to_yaml(run.calibration, run.holdout ? &*run.holdout : nullptr);
+    yaml = calibration_yaml(run);
   }
-  if (out) {
-    std::ofstream file(*out);
-    if (!file) throw Error(out->string() + ": cannot write");
-    file << yaml;
-    if (!file) throw Error(out->string() + ": write failed");
-  }
+  if (out) write_calibration(*out, yaml);
   const Calibration& c = run.calibration;
   py::dict d;
   d["source"] = c.source;

@@ -4,9 +4,11 @@
 #include <vector>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/calibration_file.hpp"
 #include "extwrench/io/input_file.hpp"
 #include "extwrench/io/log.hpp"
 #include "extwrench/io/number_text.hpp"
+#include "extwrench/io/output_files.hpp"
 
 namespace extwrench {
 namespace {
@@ -86,6 +88,17 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
     result.holdout =
         validate_holdout(model, config.options, result.calibration, samples, result.fit_rows);
   return result;
+}
+
+std::string calibration_yaml(const CalibrateLogResult& run) {
+  return calibration_to_yaml(run.calibration, run.holdout ? &*run.holdout : nullptr);
+}
+
+void write_calibration(const std::filesystem::path& path, std::string_view yaml) {
+  OutputFiles files;
+  if (path.has_parent_path()) files.create_directories(path.parent_path());
+  files.write_text(path, yaml);
+  files.keep();
 }
 
 }  // namespace extwrench

@@ -1,6 +1,8 @@
 #include "extwrench/io/output_files.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <system_error>
 
@@ -40,8 +42,13 @@ fs::path OutputFiles::partial_name(const fs::path& path) {
 void OutputFiles::write_text(const fs::path& path, std::string_view text) {
   const fs::path partial = stage(path);
   {
+    errno = 0;
     std::ofstream out(partial);
-    if (!out) throw Error(partial.string() + ": cannot create the file");
+    if (!out) {
+      const int reason = errno;  // open(2)'s, when it failed there
+      throw Error(partial.string() + ": cannot create the file" +
+                  (reason != 0 ? std::string(": ") + std::strerror(reason) : std::string()));
+    }
     out << text;
     out.flush();
     if (!out) throw Error(partial.string() + ": write failed (disk full?)");

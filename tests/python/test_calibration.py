@@ -4,6 +4,8 @@ named by their Python keyword. The real Panda's contact-free log (../shared/real
 where present; the simulated free motion of scenarios/paper_free_motion.yaml always."""
 
 import re
+import resource
+import signal
 import subprocess
 
 import numpy as np
@@ -97,6 +99,28 @@ def test_bad_options_are_named_by_their_keyword(free_run):
 
 
 @pytest.mark.skipif(not (PANDA / "log.csv").exists(), reason="../shared/realdata is absent")
+def test_a_failed_write_keeps_the_previous_file(free_run, tmp_path):
+    """A write that fails (a file size limit stands for a full disk) raises, naming the file, and
+    leaves the calibration written before as it was: no truncated CALIB.yaml to include. The
+    first write creates the missing directory."""
+    est = extwrench.ContactEstimator(None, free_run / "ft" / "config.yaml")
+    path = tmp_path / "calibrations" / "calib.yaml"
+    extwrench.calibrate(est, free_run / "log.csv", out=path)
+    previous = path.read_bytes()
+    assert len(previous) > 1024
+    handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    limits = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (1024, limits[1]))
+    try:
+        with pytest.raises(extwrench.Error, match="calib.yaml.partial: write failed"):
+            extwrench.calibrate(est, free_run / "log.csv", holdout=0.4, out=path)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, limits)
+        signal.signal(signal.SIGXFSZ, handler)
+    assert path.read_bytes() == previous
+    assert sorted(p.name for p in path.parent.iterdir()) == ["calib.yaml"]
+
+
 def test_real_panda_holdout_is_quiet_with_calibration():
     est = extwrench.ContactEstimator(extwrench.load_robot(PANDA / "panda.urdf"),
                                      {"sensor": {"type": "none"},

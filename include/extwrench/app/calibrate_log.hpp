@@ -60,4 +60,13 @@ struct CalibrateLogResult {
                                                const std::filesystem::path& log,
                                                const CalibrationOptions& options, double holdout);
 
+/// The CALIB.yaml text of a run: calibration_to_yaml with its holdout report.
+[[nodiscard]] std::string calibration_yaml(const CalibrateLogResult& run);
+
+/// Writes CALIB.yaml text to `path` as one transaction (io/output_files.hpp: written as
+/// "<path>.partial", renamed when complete; missing directories created), so a failed write
+/// leaves no truncated calibration for a configuration to include, and an earlier file of that
+/// name as it was. Throws extwrench::Error naming the file.
+void write_calibration(const std::filesystem::path& path, std::string_view yaml);
+
 }  // namespace extwrench
