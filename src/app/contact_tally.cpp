@@ -57,7 +57,9 @@ std::string disagreement_warning(const ContactTally& tally) {
   return std::string(pct) + " of the " + std::to_string(tally.contact_samples) +
          " contact samples carry 'disagreement' (the base sensor and the joint residual do not "
          "agree): check the sensor pose (sensor.pose, or the model's 'sensor' frame), the robot "
-         "model (masses, inertias, joint order) and the sensor's calibration (bias: sensor.tare)";
+         "model (masses, inertias, joint order), the sensor's calibration (bias: sensor.tare) and "
+         "the joints' friction and torque offsets, which the residual sees and the sensor does "
+         "not (`extwrench calibrate` on a contact-free log, docs/calibration.md)";
 }
 
 std::string frequent_alarms_note(const ContactTally& tally) {

@@ -708,9 +708,11 @@ TEST(ContactTally, CountsSamplesEpisodesAndLinksAsTheLineSays) {
   EXPECT_EQ(disagreement_warning(tally), "");
   ContactTally doubtful(model.num_bodies());
   for (int k = 0; k < 20; ++k) doubtful.add(0.001 * k, true, 2, k < 11);
-  EXPECT_NE(disagreement_warning(doubtful).find("55 % of the 20 contact samples"),
-            std::string::npos)
-      << disagreement_warning(doubtful);
+  const std::string warning = disagreement_warning(doubtful);
+  EXPECT_NE(warning.find("55 % of the 20 contact samples"), std::string::npos) << warning;
+  // Every cause a user can act on: the pose, the model, the bias, the friction (calibrate).
+  for (const char* cause : {"sensor.pose", "masses", "sensor.tare", "extwrench calibrate"})
+    EXPECT_NE(warning.find(cause), std::string::npos) << cause;
 }
 
 }  // namespace

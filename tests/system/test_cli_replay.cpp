@@ -410,6 +410,9 @@ TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
   };
   const CliRun sim = cli("simulate --no-figures free.yaml --out free");
   ASSERT_EQ(sim.code, 0) << sim.err;
+  // The base sensor sees no contact where the residual sees friction: the warning names it.
+  EXPECT_TRUE(contains(sim.err, "contact samples carry 'disagreement'")) << sim.err;
+  EXPECT_TRUE(contains(sim.err, "friction and torque offsets, which the residual sees")) << sim.err;
   const CliRun cal =
       cli("calibrate --config free/ft/config.yaml --log free/log.csv --out free/calib.yaml "
           "--holdout 0.4");
