@@ -668,7 +668,9 @@ TEST(FrequentAlarmsNote, SaysCalibrateOnlyForTheModelErrorsPatterns) {
   EXPECT_EQ(frequent_alarms_note(
                 result(3600000, 30000, 30, 3600.0, {0, 0, 0, 10000, 10000, 10000, 0, 0})),
             "");
-  // Nine quick alarms.
+  // Two pushes of 1 s in 4 s, split by the paper's rule over three links (the threshold sweep
+  // example), and nine quick alarms.
+  EXPECT_EQ(frequent_alarms_note(result(4001, 2068, 2, 4.0, {0, 0, 51, 0, 998, 0, 1019, 0})), "");
   EXPECT_EQ(frequent_alarms_note(result(9752, 300, 9, 10.5, {0, 100, 100, 100, 0, 0, 0, 0})), "");
 }
 
