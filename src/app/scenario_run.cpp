@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -13,6 +14,8 @@
 #include "extwrench/app/jobs.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/estimation/isolation.hpp"
+#include "extwrench/geometry/ray.hpp"
 #include "extwrench/io/csv.hpp"
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/log.hpp"
@@ -67,10 +70,62 @@ std::vector<EstimatorConfig> write_scheme_configs(const Scenario& s,
   return configs;
 }
 
+// Where a pusher coming along an applied force's line first meets the arm, against the force's
+// own point. The geometry rule (docs/estimator.md) puts the contact there: a point inside a shape
+// (on a link's axis, as the paper's own), behind another link or in the air is then estimated on
+// another link or at another point than the truth's. Empty when the pusher meets the force's own
+// link at the point (within 5 mm) and nothing before it.
+std::string push_point_note(const Model& model, const GeometryModel& geometry, const Data& data,
+                            const sim::ForceProfile& profile, const ExternalWrench& w,
+                            std::size_t index) {
+  constexpr double kTolerance = 0.005;  // [m]
+  const double norm = w.force_W.norm();
+  if (!(norm > 0.0)) return {};
+  const Vector3 u = w.force_W / norm;
+  double first = std::numeric_limits<double>::infinity(), own = first;
+  int first_body = -1;
+  for (int b = 0; b < model.num_bodies(); ++b) {
+    const auto k = static_cast<std::size_t>(b);
+    if (k >= geometry.body_shapes.size() || geometry.body_shapes[k].empty()) continue;
+    const SurfacePointResult hit =
+        intersect_line_with_body(geometry, b, data.X_WB[k], w.point_W, u, OnMiss::kNothing);
+    if (!hit.hit) continue;
+    if (b == w.body) own = hit.entry.lambda;
+    if (hit.entry.lambda < first) {
+      first = hit.entry.lambda;
+      first_body = b;
+    }
+  }
+  if (std::abs(own) <= kTolerance && first >= -kTolerance) return {};
+  char where[128];
+  std::snprintf(where, sizeof where, "forces[%zu] (%s, point (%s, %s, %s))", index,
+                profile.frame.c_str(), format_number(profile.point_F.x()).c_str(),
+                format_number(profile.point_F.y()).c_str(),
+                format_number(profile.point_F.z()).c_str());
+  const auto cm = [](double metres) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f cm", 100.0 * std::abs(metres));
+    return std::string(text);
+  };
+  std::string what;
+  if (first_body < 0) {
+    what = "its line meets no collision shape of the arm";
+  } else {
+    const std::string& body = model.bodies[static_cast<std::size_t>(first_body)].name;
+    what = first < 0.0
+               ? "a pusher along the force meets " + body + " " + cm(first) + " before the point" +
+                     (first_body == w.body ? " (the point lies inside the link's shape)" : "")
+               : "the point lies " + cm(first) + " in front of " + body + "'s surface, in the air";
+  }
+  return std::string(where) + ": " + what;
+}
+
 // The closed-loop simulation of one seed into r.dir/log.csv, with the estimator's (believed)
 // model in the controller; counts the samples and tracks the peak of cond(J of O_l) at the true q.
+// `geometry_schemes`: the schemes that isolate on geometry ("'ft', 'none'"); empty: the applied
+// forces' points are not checked (push_point_note).
 void simulate_seed(const Scenario& s, const Model& believed, int singular_body, bool progress_on,
-                   OutputFiles& outputs, SeedResult& r) {
+                   const std::string& geometry_schemes, OutputFiles& outputs, SeedResult& r) {
   const Model& model = s.robot.model;
   sim::SimulationConfig sc = s.simulation;
   sc.noise_seed = 2 * r.seed + 1;
@@ -102,8 +157,28 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   const std::string label = "seed " + std::to_string(r.seed);
   detail::ProgressLine progress(progress_on, 256, std::chrono::milliseconds(200), total);
   bool above = false;
+  // Each applied force's point is checked once, at its first active sample.
+  std::vector<sim::ForceProfile> forces = s.simulation.forces;
+  for (sim::ForceProfile& f : forces) f.resolve(model);
+  std::vector<bool> pending(forces.size(), !geometry_schemes.empty());
   while (simulator.next(sample)) {
     log.write(sample);
+    for (std::size_t k = 0; k < pending.size(); ++k) {
+      const sim::ForceProfile& profile = forces[k];
+      if (!pending[k] || profile.scale(sample.t) == 0.0) continue;
+      pending[k] = false;
+      forward_kinematics(model, data, sample.q);
+      ExternalWrench w;
+      if (!profile.evaluate(sample.t, data, w)) continue;
+      const std::string note = push_point_note(model, s.robot.geometry, data, profile, w, k);
+      if (note.empty()) continue;
+      const bool several = geometry_schemes.find(',') != std::string::npos;
+      r.notes.push_back(note + ". Geometry isolation (scheme" + (several ? "s " : " ") +
+                        geometry_schemes +
+                        ") estimates the contact where a pusher meets the arm, not at the "
+                        "point: put the point on the link's surface, or set `isolation: "
+                        "residual` in the scheme, as scenarios/paper.yaml does");
+    }
     if (singular_body > 0) {
       forward_kinematics(model, data, sample.q);
       const double c = jacobian_condition(model, data, singular_body);
@@ -244,7 +319,13 @@ void simulate_job(const Scenario& s, int singular_body, bool progress, OutputFil
              geometry_with_mesh_files(s.robot.geometry, r.dir, outputs));
   outputs.commit(urdf);
   job.configs = write_scheme_configs(s, r.dir, outputs);
-  simulate_seed(s, believed, singular_body, progress, outputs, r);
+  std::string geometry_schemes;
+  for (std::size_t k = 0; k < job.configs.size(); ++k) {
+    const EstimatorConfig& c = job.configs[k];
+    if (resolved_rule(c.options.isolation, c.robot.geometry) != IsolationRule::kGeometry) continue;
+    geometry_schemes += (geometry_schemes.empty() ? "'" : ", '") + s.schemes[k].name + "'";
+  }
+  simulate_seed(s, believed, singular_body, progress, geometry_schemes, outputs, r);
   job.windows = metric_windows(s, r, singular_body);
 }
 
@@ -306,11 +387,16 @@ std::vector<SeedResult> run_jobs_of(const Scenario& s, const std::filesystem::pa
       jobs);
   if (const std::size_t failed = simulated.first_failure(); failed < n_seeds)
     rethrow_first_failure(simulated, seed_label(failed));
+  std::ostream& console = options.messages != nullptr ? *options.messages : std::cerr;
+  for (std::size_t i = 0; i < n_seeds; ++i) {
+    const std::string label = seed_label(i);
+    for (const std::string& note : seeds[i].result.notes)
+      console << "extwrench: note: " << (label.empty() ? "" : label + ": ") << note << "\n";
+  }
 
   std::vector<OutputFiles*> replay_outputs(n_seeds * n_schemes);
   std::vector<std::ostringstream> messages(replay_outputs.size());
   for (auto& o : replay_outputs) o = &transactions.add();
-  std::ostream& console = options.messages != nullptr ? *options.messages : std::cerr;
   const JobOutcomes replayed = run_jobs(
       replay_outputs.size(),
       [&](std::size_t k) {

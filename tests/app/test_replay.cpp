@@ -476,6 +476,50 @@ TEST_F(Replay, EstimateFedOnlyTheWrittenFilesReproducesSimulateByteForByte) {
   }
 }
 
+// A scenario's pushes as geometry isolation sees them: on link4's axis (inside its capsule: the
+// capsule has radius 7 cm about z, from z = 4 to 16 cm), on its surface, and 5 cm in front of it
+// in the air. Only the surface point gets no note; with `isolation: residual` none does.
+TEST_F(Replay, PushPointsOffTheSurfaceGetANoteWhenASchemeIsolatesOnGeometry) {
+  const std::string scenario = "robot: " + kPaperArm.string() + R"(
+seeds: [1]
+duration: 0.3
+trajectory: {offset: 0.3, amplitude: 0.2, frequency: 0.5, phase: 0}
+forces:
+  - {frame: link4, force: [8, 0, 0], point: [0, 0, 0.1], start: 0.1, end: 0.15}
+  - {frame: link4, force: [8, 0, 0], point: [-0.07, 0, 0.1], start: 0.15, end: 0.2}
+  - {frame: link4, force: [8, 0, 0], point: [-0.12, 0, 0.1], start: 0.2, end: 0.25}
+schemes:
+  none: {sensor: {type: none}}
+)";
+  const fs::path dir = temp_dir("push_points");
+  write_text(dir / "s.yaml", scenario);
+  std::ostringstream messages;
+  const RunOptions options{.figures = false, .messages = &messages};
+  const std::vector<SeedResult> geometry =
+      run_scenario(load_scenario(dir / "s.yaml"), dir / "geometry", options);
+  ASSERT_EQ(geometry.size(), 1u);
+  const std::vector<std::string>& notes = geometry[0].notes;
+  ASSERT_EQ(notes.size(), 2u) << messages.str();
+  EXPECT_NE(notes[0].find("forces[0] (link4, point (0, 0, 0.1)): a pusher along the force meets "
+                          "link4 7.0 cm before the point (the point lies inside the link's shape)"),
+            std::string::npos)
+      << notes[0];
+  EXPECT_NE(notes[1].find("forces[2] (link4, point (-0.12, 0, 0.1)): the point lies 5.0 cm in "
+                          "front of link4's surface, in the air"),
+            std::string::npos)
+      << notes[1];
+  EXPECT_NE(notes[1].find("Geometry isolation (scheme 'none') estimates the contact where a "
+                          "pusher meets the arm"),
+            std::string::npos)
+      << notes[1];
+  EXPECT_NE(messages.str().find("extwrench: note: " + notes[0] + "\n"), std::string::npos)
+      << messages.str();
+  write_text(dir / "r.yaml", replace(scenario, "{sensor: {type: none}}",
+                                     "{sensor: {type: none}, isolation: residual}"));
+  EXPECT_TRUE(
+      run_scenario(load_scenario(dir / "r.yaml"), dir / "residual", options)[0].notes.empty());
+}
+
 TEST_F(Replay, CommandLineErrorsExitWithTheDocumentedCodes) {
   const fs::path dir = temp_dir("cli");
   write_text(dir / "bad.yaml", kGoodScenario + "colour: red\n");

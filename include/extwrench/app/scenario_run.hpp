@@ -27,6 +27,9 @@ struct SeedResult {
   double peak_time = 0.0;       ///< [s]
   /// The crossings: time spans where cond(J of O_l) > the scenario's singularity_threshold.
   std::vector<std::pair<double, double>> singular_spans;
+  /// Notes on the scenario printed after the simulation: an applied force whose point is not
+  /// where a pusher along it meets the arm, when a scheme isolates on geometry.
+  std::vector<std::string> notes;
   std::vector<SchemeResult> schemes;
 };
 
