@@ -48,10 +48,10 @@ struct ContactTally {
 [[nodiscard]] std::string disagreement_warning(const ContactTally& tally);
 
 /// The note for estimates whose contacts look like a model's error rather than a touch: declared
-/// anew at least once a second (10 times or more), or on 80 % of the samples or more, spread over three links or
-/// more (each with 2 % of the contact samples); with the remedy (calibrate on a contact-free log,
-/// docs/calibration.md). Empty otherwise. Meant for logs without truth and configurations without
-/// a calibration: the caller decides.
+/// anew at least once a second (10 times or more), or on 80 % of the samples or more, spread
+/// over three links or more (each with 2 % of the contact samples); with the remedy (calibrate
+/// on a contact-free log, docs/calibration.md). Empty otherwise. Meant for logs without truth
+/// and configurations without a calibration: the caller decides.
 [[nodiscard]] std::string frequent_alarms_note(const ContactTally& tally);
 
 }  // namespace extwrench
