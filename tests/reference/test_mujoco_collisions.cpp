@@ -498,8 +498,8 @@ TEST_F(MujocoCollisions, PandaCalibratedOnAFreeRunUnderEncoderQuantisation) {
         r.out_dir = dir / name;
         r.figures = false;
         r.messages = &messages;
-        disagreement =
-            replay_log(cfg.robot.model, cfg.robot.geometry, options, r).contacts.disagreement_fraction();
+        disagreement = replay_log(cfg.robot.model, cfg.robot.geometry, options, r)
+                           .contacts.disagreement_fraction();
         return measure(r.log, r.out_dir / "estimates.csv");
       };
       const Figures defaults = measure(dir / "log.csv", dir / scheme / "estimates.csv");
