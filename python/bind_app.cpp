@@ -43,6 +43,7 @@ py::list run_scenario_py(const std::filesystem::path& scenario_path,
     std::vector<std::string> schemes;
     for (const auto& s : r.schemes) schemes.push_back(s.name);
     d["schemes"] = schemes;
+    d["notes"] = r.notes;
     out.append(d);
   }
   return out;

@@ -138,8 +138,9 @@ def simulate(scenario: Union[str, os.PathLike], out_dir: Optional[Union[str, os.
     """Runs a simulation scenario (docs/simulation.md) as `extwrench simulate` does.
 
     Files go to out_dir (a temporary directory, removed afterwards, when None). Returns one dict
-    per seed: seed, dir, samples, peak_condition, peak_time, log (read_log's arrays, truth
-    included) and estimates {scheme: estimate()'s arrays}, equal to each scheme's estimates.csv.
+    per seed: seed, dir, samples, peak_condition, peak_time, notes (the run's notes on the
+    scenario, also on stderr), log (read_log's arrays, truth included) and estimates
+    {scheme: estimate()'s arrays}, equal to each scheme's estimates.csv.
     """
     if out_dir is None:
         with tempfile.TemporaryDirectory(prefix="extwrench_") as tmp:

@@ -118,6 +118,20 @@ def test_simulate_returns_the_files_numbers(paper_run):
     assert log["q"].shape == (len(rows), 7) and "true_force_W" in log
 
 
+def test_simulate_notes_a_push_no_pusher_could_reach(paper_run, tmp_path):
+    """The paper's scenario with geometry isolation: its point on link6 lies behind link7's
+    capsule along the force (docs/simulation.md); with the paper's rule (the file's) no note."""
+    assert extwrench.simulate(paper_run["scenario"])[0]["notes"] == []
+    text = paper_run["scenario"].read_text().replace("duration: 6.0", "duration: 0.2")
+    assert "duration: 0.2" in text and "isolation: residual" in text
+    scenario = tmp_path / "geometry.yaml"
+    scenario.write_text(text.replace("isolation: residual", "isolation: geometry"))
+    (run,) = extwrench.simulate(scenario)
+    assert len(run["notes"]) == 1, run["notes"]
+    assert run["notes"][0].startswith("forces[0] (link6, point (0, 0, 0.1)): a pusher along the "
+                                      "force meets link7 ")
+
+
 def test_link_candidates_of_geometry_isolation_match_the_cli(paper_run, cli):
     # The scenario's push lies outside link 6's capsule: geometry isolation names link 7 and
     # keeps link 6 as a candidate, so the column is not empty.
