@@ -189,6 +189,7 @@ py::dict calibrate_py(const Estimator& estimator, const std::filesystem::path& l
   d["warnings"] = c.warnings;
   d["holdout"] = holdout_dict(run.holdout);
   d["yaml"] = yaml;
+  d["report"] = calibration_report(run, known_torque);
   return d;
 }
 

@@ -1,5 +1,9 @@
 #include "extwrench/app/calibrate_log.hpp"
 
+#include <array>
+#include <cstdio>
+#include <iomanip>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -88,6 +92,116 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
     result.holdout =
         validate_holdout(model, config.options, result.calibration, samples, result.fit_rows);
   return result;
+}
+
+namespace {
+
+// The report's numbers: four significant digits, right-aligned in `width` columns (the exact
+// values are in CALIB.yaml).
+std::string cell(double value, int width = 8) {
+  std::array<char, 40> text{};
+  std::snprintf(text.data(), text.size(), "%*.4g", width, value == 0.0 ? 0.0 : value);
+  return text.data();
+}
+
+std::string cells(const Vector3& v) {
+  return "(" + cell(v.x(), 0) + ", " + cell(v.y(), 0) + ", " + cell(v.z(), 0) + ")";
+}
+
+}  // namespace
+
+std::string calibration_report(const CalibrateLogResult& run, bool in_contact) {
+  const Calibration& c = run.calibration;
+  const HoldoutReport* h = run.holdout ? &*run.holdout : nullptr;
+  std::ostringstream out;
+  const bool dahl = c.friction.sign == SmoothSign::kDahl;
+  out << "  joint  viscous  Coulomb   offset  " << (dahl ? "delta_q" : "    v_s")
+      << "  RMS before ->  after  var.expl  threshold [N m]\n";
+  for (std::size_t i = 0; i < c.joints.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    const JointFitReport& j = c.joints[i];
+    out << "  " << std::left << std::setw(5) << i + 1 << std::right << cell(c.friction.viscous[k])
+        << " " << cell(c.friction.coulomb[k]) << " " << cell(c.friction.offset[k]) << " "
+        << cell(dahl ? c.friction.presliding[k] : c.friction.smoothing(k)) << "  "
+        << cell(j.rms_before) << " -> " << cell(j.rms_after, 6) << "  "
+        << cell(j.variance_explained) << "  " << cell(j.threshold, 0);
+    if (j.speed_dependent)
+      out << " + " << cell(j.threshold_per_speed, 0) << " |dq| (constant would be "
+          << cell(j.threshold_constant, 0) << ")";
+    out << (j.threshold_from_max ? " (largest residual)" : " (gaussian)") << "\n";
+  }
+  if ((c.residual_cutoff.array() > 0.0).any()) {
+    out << "  residual filter [Hz]:";
+    for (Eigen::Index i = 0; i < c.residual_cutoff.size(); ++i)
+      out << " " << cell(c.residual_cutoff[i], 0);
+    out << " (RMS, noise and thresholds are of the filtered residual)\n";
+  }
+  if (c.inertia_correction.size() > 0 && !c.inertia_correction.isZero(0.0)) {
+    out << "  inertia correction [kg m^2] (p = B(q) dq + dI dq):";
+    for (Eigen::Index i = 0; i < c.inertia_correction.size(); ++i)
+      out << " " << cell(c.inertia_correction[i], 0);
+    out << "\n";
+  }
+  if (c.sensor_type != SensorType::kNone) {
+    out << "  sensor bias [f; n] (S): " << cells(Vector3(c.sensor_bias_S.head<3>())) << " N, "
+        << cells(Vector3(c.sensor_bias_S.tail<3>())) << " N m; F_min " << cell(c.force_threshold, 0)
+        << " N\n";
+  }
+  if (c.payload.identified) {
+    out << "  payload on link " << c.payload.body << ": " << cell(c.payload.mass, 0) << " kg, CoM "
+        << cells(c.payload.com) << " m (link frame); sensor RMS per axis "
+        << cells(Vector3(c.payload.rms_before.head<3>())) << " N "
+        << cells(Vector3(c.payload.rms_before.tail<3>())) << " N m -> "
+        << cells(Vector3(c.payload.rms_after.head<3>())) << " N "
+        << cells(Vector3(c.payload.rms_after.tail<3>())) << " N m\n";
+  }
+  out << "  model check: residual RMS per joint before calibration [";
+  for (Eigen::Index i = 0; i < c.model_check.joint_rms.size(); ++i)
+    out << (i ? " " : "") << cell(c.model_check.joint_rms[i], 0);
+  out << "] N m";
+  if (c.sensor_type != SensorType::kNone)
+    out << "; sensor error RMS " << cells(Vector3(c.model_check.sensor_rms.head<3>())) << " N "
+        << cells(Vector3(c.model_check.sensor_rms.tail<3>())) << " N m";
+  out << "\n";
+  for (const ModelPattern& p : c.model_check.patterns) out << "    " << p.message << "\n";
+  if (c.model_check.patterns.empty()) out << "    no recognisable model error\n";
+  if (h == nullptr) return out.str();
+  out << "  holdout: " << h->samples << " samples (" << cell(h->duration, 0)
+      << " s): " << h->false_alarms
+      << (in_contact ? " samples with contact declared (the log is in contact: not false "
+                       "alarms) ("
+                     : " false-alarm samples (")
+      << cell(h->samples ? 100.0 * h->false_alarms / h->samples : 0.0, 0) << " %), uncalibrated "
+      << h->uncalibrated_false_alarms << ", calibrated with constant thresholds "
+      << h->constant_threshold_false_alarms << "\n"
+      << "  joint " << std::setw(22) << "calibrated threshold"
+      << " | smallest quiet constant: " << std::setw(12) << "uncalibrated" << std::setw(12)
+      << "calibrated"
+      << "  [N m]\n";
+  for (Eigen::Index i = 0; i < h->calibrated_threshold.size(); ++i)
+    out << "  " << std::left << std::setw(6) << i + 1 << std::right
+        << cell(h->calibrated_threshold[i], 22) << " | " << std::setw(26) << ""
+        << cell(h->best_constant_threshold[i], 12) << cell(h->calibrated_max_residual[i], 12)
+        << "\n";
+  out << "  smallest force detectable at " << cell(h->lever, 0)
+      << " m [N] (median over the holdout), with\n"
+      << "  link " << std::setw(23) << "calibrated thresholds" << std::setw(16) << "(constant form)"
+      << " | smallest quiet constant: " << std::setw(12) << "uncalibrated" << std::setw(12)
+      << "calibrated"
+      << "\n";
+  for (std::size_t l = 1; l < h->min_force_calibrated.size(); ++l)
+    out << "  " << std::left << std::setw(5) << l << std::right
+        << cell(h->min_force_calibrated[l], 23) << cell(h->min_force_calibrated_constant[l], 16)
+        << " | " << std::setw(26) << "" << cell(h->min_force_constant[l], 12)
+        << cell(h->min_force_calibrated_quiet[l], 12) << "\n";
+  if (h->tracking_rms_calibrated.size() == 0) return out.str();
+  out << "  joint  RMS of residual - true_tau_ext on the holdout [N m]: uncalibrated -> "
+         "calibrated\n";
+  for (Eigen::Index i = 0; i < h->tracking_rms_calibrated.size(); ++i)
+    out << "  " << std::left << std::setw(5) << i + 1 << std::right
+        << cell(h->tracking_rms_uncalibrated[i]) << " -> " << cell(h->tracking_rms_calibrated[i])
+        << "\n";
+  return out.str();
 }
 
 std::string calibration_yaml(const CalibrateLogResult& run) {

@@ -36,13 +36,17 @@ def free_run(cli, tmp_path_factory):
 def test_calibrate_writes_the_clis_file_and_reports_it(free_run, cli, tmp_path):
     config = free_run / "ft" / "config.yaml"
     log = free_run / "log.csv"
-    subprocess.run([cli, "calibrate", "--config", str(config), "--log", str(log), "--out",
-                    str(tmp_path / "cli.yaml"), "--holdout", "0.4"], check=True,
-                   capture_output=True)
+    run = subprocess.run([cli, "calibrate", "--config", str(config), "--log", str(log), "--out",
+                          str(tmp_path / "cli.yaml"), "--holdout", "0.4"], check=True,
+                         capture_output=True, text=True)
     est = extwrench.ContactEstimator(None, config)
     cal = extwrench.calibrate(est, log, holdout=0.4, out=tmp_path / "py.yaml")
     assert (tmp_path / "py.yaml").read_text() == (tmp_path / "cli.yaml").read_text()
     assert cal["yaml"] == (tmp_path / "cli.yaml").read_text()
+    # The printed report: the command's stdout after its first line (rows, time, file).
+    first, rest = run.stdout.split("\n", 1)
+    assert first.startswith("extwrench calibrate: 8001 rows, fit on 4800 (")
+    assert cal["report"] == rest and "holdout: 3201 samples" in rest
     # The report as values, against the scenario's friction (docs/calibration.md's rehearsal).
     n = est.nq
     assert cal["rows"] == 8001 and cal["fit_rows"] == int(8001 * 0.6)

@@ -60,6 +60,15 @@ struct CalibrateLogResult {
                                                const std::filesystem::path& log,
                                                const CalibrationOptions& options, double holdout);
 
+/// The report `extwrench calibrate` prints under its first line (Python's calibrate returns it
+/// as "report"): per joint the friction, the residual's RMS before and after, the variance
+/// explained and the threshold; the residual filter, inertia correction, sensor bias and payload
+/// when there are any; the model check; with a holdout, its false alarms, thresholds and the
+/// smallest forces detectable per link. `in_contact`: the log holds a known contact
+/// (--known-torque), so its contact samples are not called false alarms. Four significant
+/// digits (CALIB.yaml has the exact values); the warnings are not in it (Calibration::warnings).
+[[nodiscard]] std::string calibration_report(const CalibrateLogResult& run, bool in_contact);
+
 /// The CALIB.yaml text of a run: calibration_to_yaml with its holdout report.
 [[nodiscard]] std::string calibration_yaml(const CalibrateLogResult& run);
 
