@@ -142,26 +142,15 @@ class WindowMetrics {
   std::vector<sim::MetricsAccumulator> accumulators_;
 };
 
-/// Rows replayed and the time span they cover.
-struct LogSpan {
-  long rows = 0;
-  double t_begin = std::numeric_limits<double>::quiet_NaN();
-  double t_end = std::numeric_limits<double>::quiet_NaN();
-  void add(double t) {
-    if (std::isnan(t_begin)) t_begin = t;
-    t_end = t;
-    ++rows;
-  }
-};
-
-MetricsReport report_of(const ReplayOptions& o, const LogSpan& span) {
+// The report's header; the rows and time span are the tally's (every replayed estimate).
+MetricsReport report_of(const ReplayOptions& o, const ContactTally& tally) {
   MetricsReport report;
   report.scheme = title_of(o);
   report.log = o.log.string();
   report.config = o.config_label;
-  report.rows = span.rows;
-  report.t_begin = span.t_begin;
-  report.t_end = span.t_end;
+  report.rows = tally.rows;
+  report.t_begin = tally.t_begin;
+  report.t_end = tally.t_end;
   report.surface_metrics = o.surface_metrics;
   return report;
 }
@@ -215,7 +204,6 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   }
   const std::string title = title_of(o);
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
-  LogSpan span;
   ContactTally contacts(model.num_bodies());
   const std::string log_name = reader.name();  // the reader belongs to its thread from here on
   detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype());
@@ -223,22 +211,22 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     const Sample& s = *sample;
     const ContactEstimate& e = estimator.update(s);
     pipeline.push(e);
-    span.add(s.t);
     contacts.add(s.t, e.contact, e.link, e.has(EstimateFlag::kDisagreement));
     if (layout.truth) metrics.add(s, e);
     if (figures) figures->add(s, e, estimator.detector());
-    progress.update(span.rows, "%s: replayed %ld rows (t = %.1f s)", title.c_str(), span.rows, s.t);
+    progress.update(contacts.rows, "%s: replayed %ld rows (t = %.1f s)", title.c_str(),
+                    contacts.rows, s.t);
   }
   progress.done();
   pipeline.finish();
   writer.close();
-  if (span.rows == 0) throw Error(log_name + ": the log has a header but no rows");
+  if (contacts.rows == 0) throw Error(log_name + ": the log has a header but no rows");
   outputs.commit(estimates);
 
   ReplayResult result;
-  result.rows = span.rows;
+  result.rows = contacts.rows;
   result.has_truth = layout.truth;
-  result.report = report_of(o, span);
+  result.report = report_of(o, contacts);
   result.contacts = std::move(contacts);
   if (layout.truth) {
     result.report.windows = metrics.result();

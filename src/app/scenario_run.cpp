@@ -122,10 +122,10 @@ std::string push_point_note(const Model& model, const GeometryModel& geometry, c
 
 // The closed-loop simulation of one seed into r.dir/log.csv, with the estimator's (believed)
 // model in the controller; counts the samples and tracks the peak of cond(J of O_l) at the true q.
-// `geometry_schemes`: the schemes that isolate on geometry ("'ft', 'none'"); empty: the applied
-// forces' points are not checked (push_point_note).
+// `push_point_advice`: what follows a push_point_note, naming the schemes that isolate on
+// geometry; empty (no such scheme): the applied forces' points are not checked.
 void simulate_seed(const Scenario& s, const Model& believed, int singular_body, bool progress_on,
-                   const std::string& geometry_schemes, OutputFiles& outputs, SeedResult& r) {
+                   const std::string& push_point_advice, OutputFiles& outputs, SeedResult& r) {
   const Model& model = s.robot.model;
   sim::SimulationConfig sc = s.simulation;
   sc.noise_seed = 2 * r.seed + 1;
@@ -160,7 +160,7 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   // Each applied force's point is checked once, at its first active sample.
   std::vector<sim::ForceProfile> forces = s.simulation.forces;
   for (sim::ForceProfile& f : forces) f.resolve(model);
-  std::vector<bool> pending(forces.size(), !geometry_schemes.empty());
+  std::vector<bool> pending(forces.size(), !push_point_advice.empty());
   while (simulator.next(sample)) {
     log.write(sample);
     for (std::size_t k = 0; k < pending.size(); ++k) {
@@ -171,13 +171,7 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
       ExternalWrench w;
       if (!profile.evaluate(sample.t, data, w)) continue;
       const std::string note = push_point_note(model, s.robot.geometry, data, profile, w, k);
-      if (note.empty()) continue;
-      const bool several = geometry_schemes.find(',') != std::string::npos;
-      r.notes.push_back(note + ". Geometry isolation (scheme" + (several ? "s " : " ") +
-                        geometry_schemes +
-                        ") estimates the contact where a pusher meets the arm, not at the "
-                        "point: put the point on the link's surface, or set `isolation: "
-                        "residual` in the scheme, as scenarios/paper.yaml does");
+      if (!note.empty()) r.notes.push_back(note + push_point_advice);
     }
     if (singular_body > 0) {
       forward_kinematics(model, data, sample.q);
@@ -319,13 +313,22 @@ void simulate_job(const Scenario& s, int singular_body, bool progress, OutputFil
              geometry_with_mesh_files(s.robot.geometry, r.dir, outputs));
   outputs.commit(urdf);
   job.configs = write_scheme_configs(s, r.dir, outputs);
-  std::string geometry_schemes;
+  std::string names;
+  int geometry_schemes = 0;
   for (std::size_t k = 0; k < job.configs.size(); ++k) {
     const EstimatorConfig& c = job.configs[k];
     if (resolved_rule(c.options.isolation, c.robot.geometry) != IsolationRule::kGeometry) continue;
-    geometry_schemes += (geometry_schemes.empty() ? "'" : ", '") + s.schemes[k].name + "'";
+    names += (geometry_schemes++ == 0 ? "'" : ", '") + s.schemes[k].name + "'";
   }
-  simulate_seed(s, believed, singular_body, progress, geometry_schemes, outputs, r);
+  const std::string advice =
+      geometry_schemes == 0
+          ? std::string()
+          : ". Geometry isolation (scheme" + std::string(geometry_schemes > 1 ? "s " : " ") +
+                names +
+                ") estimates the contact where a pusher meets the arm, not at the point: put "
+                "the point on the link's surface, or set `isolation: residual` in the scheme, "
+                "as scenarios/paper.yaml does";
+  simulate_seed(s, believed, singular_body, progress, advice, outputs, r);
   job.windows = metric_windows(s, r, singular_body);
 }
 
