@@ -109,6 +109,18 @@ void register_calibrate(CLI::App& app) {
                 "correction), kept where it lowers the joint's residual by 10 % or more beyond a "
                 "gravity error; best with observer.residual_cutoff on noisy joints");
   add_package_path_option(*sub, opt->package_path);
+  sub->footer(help_footer(
+      {{"extwrench calibrate --config panda.yaml --log free.csv --out calib.yaml --holdout 0.4",
+        "fit on the first 60 % of a contact-free log, report false alarms and the smallest "
+        "detectable forces on the rest; then add `calibration: calib.yaml` to panda.yaml"},
+       {"extwrench calibrate --config results/free/ft/config.yaml --log results/free/log.csv "
+        "--out results/free/calib.yaml --holdout 0.4",
+        "the rehearsal on `extwrench simulate scenarios/paper_free_motion.yaml --out "
+        "results/free`"},
+       {"extwrench calibrate --config leg.yaml --log push.csv --out calib.yaml --known-torque",
+        "a log in contact whose true_tau_ext1..n columns hold the known external torque (a "
+        "force plate's J_v^T F)"}},
+      "docs/calibration.md (the procedure on a real robot), docs/cli.md (calibrate)"));
   sub->callback([opt]() { run_calibrate(*opt); });
 }
 

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -80,6 +81,18 @@ void print_metrics_row(const std::string& scheme, const std::string& seed, const
 /// Adds `--jobs N` (N ≥ 1, else a usage error; default app/jobs.hpp's default_jobs(), the
 /// number of cores) to a subcommand; `what` names the jobs ("Logs replayed").
 void add_jobs_option(CLI::App& sub, int& jobs, const std::string& what);
+
+/// One example of a command's --help: the command line and what it does.
+struct HelpExample {
+  const char* command;
+  const char* what;
+};
+
+/// The end of a command's --help: its examples (each command line, then what it does, indented
+/// below it), then where its documentation is. Every command's help ends with such a footer, so
+/// a newcomer sees a working command line beside the options.
+[[nodiscard]] std::string help_footer(std::initializer_list<HelpExample> examples,
+                                      const std::string& documentation);
 
 /// Number for humans: up to 10 significant digits ("17.9", "-0.0875", "1e-06").
 [[nodiscard]] std::string fmt(double value);

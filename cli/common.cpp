@@ -154,6 +154,43 @@ void add_jobs_option(CLI::App& sub, int& jobs, const std::string& what) {
       ->check(CLI::Range(1, 1024));
 }
 
+namespace {
+
+/// `text` wrapped at 96 columns: the first line after `first`, the others after `indent` spaces.
+std::string wrapped(std::string_view text, const std::string& first, std::size_t indent) {
+  constexpr std::size_t kWidth = 96;
+  std::string out;
+  std::string line = first;
+  bool line_has_words = false;
+  while (!text.empty()) {
+    const std::size_t space = text.find(' ');
+    const std::string_view word = text.substr(0, space);
+    text = space == std::string_view::npos ? std::string_view{} : text.substr(space + 1);
+    if (line_has_words && line.size() + 1 + word.size() > kWidth) {
+      out += line + "\n";
+      line = std::string(indent, ' ');
+      line_has_words = false;
+    }
+    line += (line_has_words ? " " : "") + std::string(word);
+    line_has_words = true;
+  }
+  return out + line + "\n";
+}
+
+}  // namespace
+
+std::string help_footer(std::initializer_list<HelpExample> examples,
+                        const std::string& documentation) {
+  // Command lines stay whole (to be copied); the rest wraps for a terminal.
+  std::string text = "\nExamples:\n";
+  for (const HelpExample& example : examples) {
+    text += std::string("  ") + example.command + "\n" + wrapped(example.what, "      ", 6);
+  }
+  text += "\n" + wrapped(documentation, "Documentation: ", 15);
+  text.pop_back();  // CLI11 ends the help with its own newline
+  return text;
+}
+
 std::string fmt(double value) {
   if (value == 0.0) return "0";  // also turns -0 into 0
   std::array<char, 32> text{};

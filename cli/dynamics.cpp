@@ -152,9 +152,16 @@ void register_dynamics(CLI::App& app) {
       "sensor\n"
       "origin, in the sensor frame (link 0's weight included). Numbers are written in the "
       "shortest\n"
-      "form that reads back to the same double.\n\n"
-      "Example:\n"
-      "  extwrench dynamics --robot models/paper_arm.yaml --in states.csv --out predicted.csv");
+      "form that reads back to the same double.\n" +
+      help_footer({{"extwrench dynamics --robot models/paper_arm.yaml --in states.csv --out "
+                    "predicted.csv",
+                    "joint torques and the base sensor's reading for each row t, q1..qn, "
+                    "dq1..dqn, ddq1..ddqn"},
+                   {"extwrench dynamics --robot models/paper_arm.urdf --sensor-pose \"0 0 -0.05 "
+                    "0 0 3.1416\" --in states.csv --out -",
+                    "the same with the sensor 5 cm below the root link, turned by 180 deg; CSV "
+                    "to stdout"}},
+                  "docs/cli.md (dynamics, CSV), docs/conventions.md (frames and signs)"));
   sub->callback([opt, pose_option] {
     opt->sensor_pose_given = pose_option->count() > 0;
     run_dynamics(*opt);

@@ -253,6 +253,19 @@ void register_estimate(CLI::App& app) {
                 "without it they are an error");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
+  sub->footer(help_footer(
+      {{"extwrench estimate --config results/paper/seed_1/ft/config.yaml --log "
+        "results/paper/seed_1/log.csv --out results/replay",
+        "replay the log that `extwrench simulate scenarios/paper.yaml --out results/paper` wrote, "
+        "with its base F/T scheme's configuration"},
+       {"extwrench estimate --config panda.yaml --log free.csv --out results/panda",
+        "a real arm's log (no truth columns): estimates.csv, figures, and a `contact:` summary; "
+        "run `extwrench calibrate` first if it reports contacts the arm never had"},
+       {"extwrench estimate --config panda.yaml --log 'logs/*.csv' --out results/sweep --jobs 2",
+        "every log matching the pattern, two at a time: "
+        "results/sweep/<log name>/estimates.csv..."}},
+      "docs/cli.md (estimate), docs/config.md (CONFIG.yaml), docs/log_format.md (the CSV "
+      "files)"));
   sub->callback([opt]() { run_estimate(*opt); });
 }
 

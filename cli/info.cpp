@@ -157,7 +157,16 @@ void register_info(CLI::App& app) {
   sub->add_option("--tip-body", opt->tip_body,
                   "MJCF only: keep only the chain from the root body to BODY")
       ->type_name("BODY");
-  sub->footer("\nExample:\n  extwrench info models/paper_arm.urdf");
+  sub->footer(help_footer(
+      {{"extwrench info models/paper_arm.urdf",
+        "the paper's arm: bodies, joints q1..q7 (the CSV columns' order), frames, sensor pose, "
+        "shapes"},
+       {"extwrench info panda.urdf --package-path ~/ws/src --lock panda_finger_joint1=0.02 "
+        "--lock panda_finger_joint2=0.02",
+        "a robot whose meshes are package:// URIs, its fingers held fixed (a tree made a chain)"},
+       {"extwrench info models/paper_arm.xml",
+        "the same arm from MJCF (when extwrench is built with MuJoCo; docs/mujoco.md)"}},
+      "docs/cli.md (info), docs/model.md (what a robot file may contain)"));
   sub->callback([opt] { run_info(*opt); });
 }
 

@@ -34,7 +34,7 @@ Examples:
   extwrench estimate --config scheme.yaml --log 'logs/*.csv' --out results/sweep --jobs 2
       every log matching the pattern, two at a time; results/sweep/<log name>/estimates.csv...
   extwrench COMMAND --help
-      all options of one command
+      all options of one command, with its examples
 
 Units are SI and radians throughout. Exit status: 0 success, 1 bad input file, 2 bad command line.
 Documentation: docs/cli.md (commands, CSV), docs/log_format.md, docs/config.md, README.md.)";

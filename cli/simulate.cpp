@@ -158,6 +158,15 @@ void register_simulate(CLI::App& app) {
   add_figure_format_option(*sub, opt->figure_format);
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
+  sub->footer(help_footer(
+      {{"extwrench simulate scenarios/paper.yaml --out results/paper",
+        "the paper's experiment (Section IV): the closed loop, then every estimator scheme on its "
+        "log; metrics and figures"},
+       {"extwrench simulate scenarios/paper_free_motion.yaml --out results/free --no-figures",
+        "a contact-free motion logged as a real arm logs it (friction, offsets, noise): the log "
+        "to rehearse `extwrench calibrate` on"}},
+      "docs/simulation.md (scenario files), docs/cli.md (outputs), docs/mujoco.md (engine: "
+      "mujoco)"));
   sub->callback([opt]() { run_simulate(*opt); });
 }
 

@@ -112,6 +112,53 @@ TEST_F(Cli, EachCommandHasItsOwnHelp) {
   EXPECT_TRUE(contains(i.out, "ROBOT"));
 }
 
+TEST_F(Cli, EachCommandsHelpShowsItsOwnExamples) {
+  // Each command's --help ends with command lines of that command, whose options are its own,
+  // whose repository files exist, then the documentation to read; the text wraps for a terminal.
+  const fs::path source(EXTWRENCH_SOURCE_DIR);
+  for (const std::string command : {"info", "dynamics", "estimate", "simulate", "calibrate"}) {
+    SCOPED_TRACE(command);
+    const RunResult r = run(command + " --help");
+    ASSERT_EQ(r.code, 0);
+    const std::size_t examples_at = r.out.find("\nExamples:\n");
+    ASSERT_NE(examples_at, std::string::npos);
+    const std::string options = r.out.substr(0, examples_at);
+    std::istringstream footer(r.out.substr(examples_at));
+    std::vector<std::string> words;
+    int command_lines = 0;
+    bool documentation = false;
+    for (std::string line; std::getline(footer, line);) {
+      if (line.rfind("  extwrench ", 0) == 0) {
+        EXPECT_EQ(line.rfind("  extwrench " + command + " ", 0), 0u) << line;
+        ++command_lines;
+        std::istringstream split(line);
+        for (std::string word; split >> word;) {
+          if (word.rfind("--", 0) == 0) {
+            EXPECT_TRUE(contains(options, word + " ")) << line;
+          }
+          words.push_back(word);
+        }
+        continue;
+      }
+      EXPECT_LE(line.size(), 100u) << line;
+      if (line.rfind("Documentation: ", 0) == 0) documentation = true;
+      std::istringstream split(line);
+      for (std::string word; split >> word;) words.push_back(word);
+    }
+    EXPECT_GE(command_lines, 1);
+    EXPECT_TRUE(documentation);
+    for (std::string word : words) {  // files of the repository named in the help exist
+      while (!word.empty() && std::string("`,;)").find(word.back()) != std::string::npos)
+        word.pop_back();
+      for (const char* folder : {"models/", "scenarios/", "docs/"}) {
+        if (word.rfind(folder, 0) == 0) {
+          EXPECT_TRUE(fs::exists(source / word)) << word;
+        }
+      }
+    }
+  }
+}
+
 TEST_F(Cli, VersionIsTheOneInCMakeLists) {
   // The version, read from the project's CMakeLists.txt by the test, not by the build.
   const std::string cmake = read_text(fs::path(EXTWRENCH_SOURCE_DIR) / "CMakeLists.txt");
