@@ -18,6 +18,7 @@ namespace {
 
 using calibration_detail::JointFrictionFit;
 using calibration_detail::JointSeries;
+using calibration_detail::number_text;
 
 // A residual transient is over after this many time constants 1/K (e^{-5} < 1 %).
 constexpr double kSettleTimeConstants = 5.0;
@@ -34,7 +35,7 @@ constexpr double kMaxUnexplainedShare = 0.5;
 void check_samples(const std::vector<Sample>& samples, int n, bool known_external_torque) {
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const Sample& s = samples[k];
-    const std::string where = "sample " + std::to_string(k) + " (t = " + std::to_string(s.t) + ")";
+    const std::string where = "sample " + std::to_string(k) + " (t = " + number_text(s.t, 6) + ")";
     if (known_external_torque && !s.has_true_tau_ext) {
       throw Error(where +
                   ": no known external torque (true_tau_ext1..n) for a calibration in contact");
@@ -331,8 +332,8 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
     cal.warnings.push_back(
         "joint " + std::to_string(i + 1) + ": after calibration the residual's RMS is " +
         std::to_string(static_cast<int>(std::lround(100.0 * share))) +
-        " % of the measured torque's over [" + std::to_string(cal.t_begin) + ", " +
-        std::to_string(cal.t_end) +
+        " % of the measured torque's over [" + number_text(cal.t_begin, 6) + ", " +
+        number_text(cal.t_end, 6) +
         "] s: the model explains little of it; a contact during most of the log (the fit "
         "cannot tell it from the robot), or a wrong model. With a known external torque "
         "(a force plate), calibrate in contact (--known-torque)");
@@ -384,6 +385,14 @@ void gravity_series(const Model& model, const std::vector<Sample>& samples, bool
       js.payload_gravity[0][k] = g[1][i] - g[0][i];
       for (std::size_t a = 1; a < 4; ++a) js.payload_gravity[a][k] = g[a + 1][i] - g[1][i];
     }
+  }
+  // About a vertical axis no mass gives a torque: what the pass computed there is rounding
+  // (~1e-15 N m, yet it follows the configuration), which a regression would scale up into a
+  // pattern ("-4e+14 times the model's gravity torque") or a nuisance column. Exactly zero.
+  for (JointSeries& js : series) {
+    if (!js.axis_along_gravity) continue;
+    std::fill(js.gravity.begin(), js.gravity.end(), 0.0);
+    for (std::vector<double>& p : js.payload_gravity) std::fill(p.begin(), p.end(), 0.0);
   }
 }
 
@@ -507,7 +516,7 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   const auto used = static_cast<int>(std::count(use.begin(), use.end(), 1));
   if (used < parameters) {
     throw Error("calibration: " + std::to_string(used) + " samples after the first " +
-                std::to_string(settle) + " s (the residual's settling) for " +
+                number_text(settle) + " s (the residual's settling) for " +
                 std::to_string(parameters) + " parameters: record a longer motion");
   }
   // The model the estimator will use: payload included.
@@ -605,8 +614,8 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
     const auto left = static_cast<int>(std::count(use.begin(), use.end(), 1));
     std::string list;
     for (const SuspectWindow& w : cal.suspect_windows)
-      list += " [" + std::to_string(w.t_begin) + ", " + std::to_string(w.t_end) + "] s (joint " +
-              std::to_string(w.joint) + ", " + std::to_string(w.peak) + " N m)";
+      list += " [" + number_text(w.t_begin, 6) + ", " + number_text(w.t_end, 6) + "] s (joint " +
+              std::to_string(w.joint) + ", " + number_text(w.peak, 3) + " N m)";
     if (used - left > o.max_contact_fraction * used || left < parameters) {
       std::string hint = "; record free motion only";
       if (o.sign != SmoothSign::kDahl && most_follow_reversals(cal.suspect_windows, samples))

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <tuple>
@@ -185,6 +186,12 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
   return f;
 }
 
+std::string number_text(double value, int digits) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.*g", digits, value == 0.0 ? 0.0 : value);  // no "-0"
+  return text;
+}
+
 std::vector<double> central_acceleration(const JointSeries& s) {
   const std::size_t N = s.dq.size();
   std::vector<double> acceleration(N, 0.0);
@@ -253,16 +260,16 @@ void check_excitation(const JointSeries& s, const std::vector<char>& use, int jo
   const std::string j = joint_name(joint);
   if (peak < kMinPeakSpeed) {
     throw Error(j + ": viscous and Coulomb friction not excited: |dq" + std::to_string(joint) +
-                "| stays below " + std::to_string(peak) + " rad/s; record a motion that moves " +
-                j + " back and forth at 0.2 rad/s or more");
+                "| stays below " + number_text(peak) + " rad/s; record a motion that moves " + j +
+                " back and forth at 0.2 rad/s or more");
   }
   const double share_up = static_cast<double>(up) / static_cast<double>(used);
   const double share_down = static_cast<double>(down) / static_cast<double>(used);
   if (share_up < kMinShareEachWay || share_down < kMinShareEachWay) {
     throw Error(j + ": Coulomb friction not excited: " + j + " moves faster than " +
-                std::to_string(smoothing) + " rad/s in the positive direction on " +
-                std::to_string(100.0 * share_up) + " % and in the negative direction on " +
-                std::to_string(100.0 * share_down) +
+                number_text(smoothing) + " rad/s in the positive direction on " +
+                number_text(100.0 * share_up, 3) + " % and in the negative direction on " +
+                number_text(100.0 * share_down, 3) +
                 " % of the samples; record a motion that moves it both ways");
   }
 }
@@ -314,7 +321,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                                  best.shift, options.sign, z_viscous, z_offset);
   if (best_solve.condition > kMaxCondition) {
     throw Error(j + ": viscous friction, Coulomb friction and offset cannot be told apart " +
-                "(condition " + std::to_string(best_solve.condition) + "); record a motion of " +
+                "(condition " + number_text(best_solve.condition, 3) + "); record a motion of " +
                 j + " with slow and fast phases in both directions");
   }
   best.viscous = best_solve.theta[0];
@@ -351,9 +358,9 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   if (keep_inertia && inertia_aliases_gravity(s, central_acceleration(s), use, correlation)) {
     keep_inertia = false;
     best.warnings.push_back(
-        j + ": an inertia correction (" + std::to_string(best_solve_with.theta[3]) +
+        j + ": an inertia correction (" + number_text(best_solve_with.theta[3], 3) +
         " kg m^2 fitted) is not applied: in this motion its acceleration follows its position " +
-        "(correlation " + std::to_string(correlation) + ", as with one sine per joint), so it " +
+        "(correlation " + number_text(correlation, 3) + ", as with one sine per joint), so it " +
         "cannot be told from a gravity error that changes with the joint's angle (a centre of " +
         "mass off); record a motion that moves " + j + " with several frequencies at once");
   }

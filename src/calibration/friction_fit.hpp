@@ -103,4 +103,8 @@ void check_excitation(const JointSeries& s, const std::vector<char>& use, int jo
 [[nodiscard]] JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                                          const CalibrationOptions& options, int joint);
 
+/// A measured value in a message, to `digits` significant digits ("0.01", "23.371", "100",
+/// "1.2e+08"): std::to_string's fixed six decimals read "0.010000 rad/s ... 100.000000 %".
+[[nodiscard]] std::string number_text(double value, int digits = 4);
+
 }  // namespace extwrench::calibration_detail

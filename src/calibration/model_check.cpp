@@ -74,11 +74,7 @@ double variance(const std::vector<double>& x, const std::vector<char>& use) {
   return n < 2 ? 0.0 : sum2 / n - (sum / n) * (sum / n);
 }
 
-std::string num(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", x);
-  return b;
-}
+std::string num(double x) { return number_text(x, 3); }
 
 // "the robot's inertia along it is |δI| kg m^2 larger|smaller than the model's (why)".
 std::string inertia_size_and_sign(double delta) {

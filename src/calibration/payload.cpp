@@ -12,6 +12,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/rnea.hpp"
+#include "friction_fit.hpp"
 #include "payload_fit.hpp"
 
 namespace extwrench::calibration_detail {
@@ -160,11 +161,11 @@ PayloadFit fit_payload(const Model& model, const Pose& X_WS, int body, bool mome
   fit.samples = static_cast<int>(rows);
   if (fit.condition > 1e6) {
     throw Error("payload: mass and centre of mass not excited (condition " +
-                std::to_string(fit.condition) +
+                number_text(fit.condition, 3) +
                 "): record a motion that accelerates the last link and turns it in gravity");
   }
   if (!(fit.mass > 0.0)) {
-    throw Error("payload: identified mass " + std::to_string(fit.mass) +
+    throw Error("payload: identified mass " + number_text(fit.mass) +
                 " kg is not positive: no payload on the last link, or a model or sensor pose "
                 "error; run without --payload");
   }
