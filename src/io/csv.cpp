@@ -217,6 +217,13 @@ void CsvReader::read_header() {
     if (row_line_ == 1 && line_.starts_with("\xEF\xBB\xBF")) line_.remove_prefix(3);  // UTF-8 BOM
     if (!trim(line_).empty()) break;
   }
+  // A robot file given where a CSV belongs (`--log arm.urdf`): say so, not "a quote inside an
+  // unquoted cell" of its XML declaration. No header of column names begins with '<'.
+  if (trim(line_).starts_with('<')) {
+    throw Error(where() +
+                "this is XML (a URDF or MJCF robot file?), but a CSV file begins with "
+                "a header row of column names");
+  }
   split_line();
   header_.assign(cells_.begin(), cells_.end());
   column_index_.clear();  // a hash map: wide logs have many columns

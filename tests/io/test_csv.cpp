@@ -170,6 +170,10 @@ TEST(CsvReader, MalformedInputsAreReportedWithFileLineAndColumn) {
       {"duplicate column", "t,q1,q1\n",
        "bad.csv:1: column 3 'q1' appears twice in the header (also column 2)"},
       {"empty column name", "t,,q1\n", "bad.csv:1: column 2 of the header has an empty name"},
+      {"a robot file (XML) given for a CSV",
+       "\xEF\xBB\xBF\n  <?xml version=\"1.0\"?>\n<robot name=\"a\">\n",
+       "bad.csv:2: this is XML (a URDF or MJCF robot file?), but a CSV file begins with a header "
+       "row of column names"},
       {"empty file", "", "bad.csv: empty file: expected a header row"},
       {"blank file", "\n \r\n", "bad.csv: empty file: expected a header row"},
   };

@@ -306,5 +306,22 @@ TEST(EstimatorConfig, MissingRobotOrRobotFileIsAnErrorNamingTheKey) {
   EXPECT_THROW((void)load_estimator_config(kDir / "does_not_exist.yaml"), Error);
 }
 
+TEST(EstimatorConfig, ARobotFileGivenForTheConfigurationIsNamedAsSuch) {
+  // `extwrench estimate --config models/paper_arm.urdf`: once "YAML syntax error: illegal map
+  // value" on line 3 of the URDF.
+  const std::filesystem::path urdf =
+      std::filesystem::path(EXTWRENCH_SOURCE_DIR) / "models" / "paper_arm.urdf";
+  try {
+    (void)load_estimator_config(urdf);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_TRUE(contains(std::string(e.what()),
+                         urdf.string() + ":1: this is XML (a URDF or MJCF robot file?), but a "
+                                         "configuration is YAML, which names the robot file "
+                                         "under 'robot:'"))
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace extwrench

@@ -1,5 +1,6 @@
 #include "yaml_reader.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -39,7 +40,20 @@ YAML::Node load_yaml_string(const std::string& text, const std::string& name) {
 }
 
 YAML::Node load_yaml_file(const std::filesystem::path& path, const std::string& what) {
-  return load_yaml_string(read_input_file(path, what), path.string());
+  const std::string text = read_input_file(path, what);
+  // A robot file given where YAML belongs (`--config arm.urdf`) would read as "illegal map value"
+  // on some line of it: say what the file is instead. No YAML document begins with '<'.
+  const std::size_t first = text.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
+  if (first != std::string::npos && text[first] == '<') {
+    const auto line =
+        std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(first), '\n') + 1;
+    const bool names_robot = what == "configuration" || what == "scenario";
+    const std::string kind = what == "robot" ? "DH robot table" : what;
+    throw Error(path.string() + ":" + std::to_string(line) +
+                ": this is XML (a URDF or MJCF robot file?), but a " + kind + " is YAML" +
+                (names_robot ? ", which names the robot file under 'robot:'" : ""));
+  }
+  return load_yaml_string(text, path.string());
 }
 
 YamlReader::YamlReader(std::string file, NumberRules rules)
