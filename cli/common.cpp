@@ -128,13 +128,14 @@ std::string metrics_header() {
 std::string metrics_row(const std::string& scheme, const std::string& seed, const sim::Metrics& m,
                         const sim::Metrics* outside, double peak_condition) {
   char line[512];
-  std::snprintf(
-      line, sizeof line, "%-12s %6s %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n", scheme.c_str(),
-      seed.c_str(), cell(m.force.rms(), "%.3f").c_str(), cell(m.force.max, "%.2f").c_str(),
-      outside ? cell(outside->force.rms(), "%.3f").c_str() : "-",
-      cell(m.line.rms(), "%.4f").c_str(), cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
-      cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
-      cell(peak_condition, "%.3g").c_str());
+  std::snprintf(line, sizeof line, "%-12s %6s %10s %9s %9s %8s m %8s m %9s %7ld %9ld %12s\n",
+                scheme.c_str(), seed.c_str(), cell(m.force.rms(), "%.3f").c_str(),
+                cell(m.force.count ? m.force.max : NAN, "%.2f").c_str(),
+                outside ? cell(outside->force.rms(), "%.3f").c_str() : "-",
+                cell(m.line.rms(), "%.4f").c_str(),
+                cell(m.line.count ? m.line.max : NAN, "%.4f").c_str(),
+                cell(100.0 * m.isolation_accuracy(), "%.2f").c_str(), m.missed, m.false_alarms,
+                cell(peak_condition, "%.3g").c_str());
   return line;
 }
 

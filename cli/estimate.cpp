@@ -115,6 +115,13 @@ void estimate_log(const EstimatorConfig& config, ReplayOptions replay,
     console << "  metrics (" << description << "), as in `extwrench simulate`:\n"
             << metrics_header() << metrics_row(replay.name, "-", m, nullptr, NAN);
     console << "  -> " << (replay.out_dir / "metrics.json").string() << "\n";
+    if (m.samples == 0) {  // a row of dashes without a word would read as a failed estimator
+      (replay.messages != nullptr ? *replay.messages : std::cerr)
+          << "extwrench estimate: warning: the metrics window (" << description
+          << ") holds none of the log's samples (t from " << format_number(r.contacts.t_begin)
+          << " to " << format_number(r.contacts.t_end)
+          << " s): its metrics are empty; see --metrics-from, --metrics-to and --exclude\n";
+    }
   }
   for (const auto& f : r.figures) console << "  figure: " << f.string() << "\n";
   for (const auto& f : r.figure_failures) console << "  figure NOT drawn: " << f << "\n";
@@ -161,7 +168,14 @@ ReplayOptions replay_options(const EstimateOptions& opt, const std::string& desc
 }
 
 void run_estimate(const EstimateOptions& opt) {
+  if (!(opt.metrics_from < opt.metrics_to)) {
+    throw UsageError("--metrics-to " + format_number(opt.metrics_to) +
+                     " must come after --metrics-from " + format_number(opt.metrics_from) +
+                     " (the metrics window is from <= t <= to)");
+  }
   std::string description = "t >= " + format_number(opt.metrics_from) + " s";
+  if (std::isfinite(opt.metrics_to))
+    description += ", t <= " + format_number(opt.metrics_to) + " s";
   for (const auto& e : opt.exclude) description += ", excluding [" + e + "] s";
   ReplayOptions common = replay_options(opt, description);  // checks --exclude
   if (!(opt.plot_points >= 10)) throw UsageError("--plot-points must be at least 10");

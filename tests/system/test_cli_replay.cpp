@@ -385,6 +385,38 @@ TEST_F(RealLog, SvgAndPdfFiguresOnRequest) {
   EXPECT_EQ(estimate(config("cfg_bad", "{type: ft}"), "bad", "--figure-format jpg").code, 2);
 }
 
+// The metrics window as a user sets it: its end is said in the table's heading, an end before
+// its start is a usage error, and a window past the log's end is a warning giving the log's
+// span, with dashes (not "0.00") in the row, where before it was a silent row of dashes.
+TEST_F(RealLog, TheMetricsWindowIsSaidAndAnEmptyOneIsWarnedAbout) {
+  const fs::path cfg = config("window", "");
+  const CliRun to =
+      estimate(cfg, "window_to", "--no-figures --metrics-from 1 --metrics-to 2", "sim/log.csv");
+  ASSERT_EQ(to.code, 0) << to.err;
+  EXPECT_TRUE(contains(to.out, "metrics (t >= 1 s, t <= 2 s), as in")) << to.out;
+  EXPECT_FALSE(contains(to.err, "holds none")) << to.err;
+
+  const CliRun reversed = estimate(cfg, "window_reversed",
+                                   "--no-figures --metrics-from 3 --metrics-to 2", "sim/log.csv");
+  EXPECT_EQ(reversed.code, 2);
+  EXPECT_TRUE(contains(reversed.err, "--metrics-to 2 must come after --metrics-from 3"))
+      << reversed.err;
+
+  const CliRun past = estimate(cfg, "window_past", "--no-figures --metrics-from 10", "sim/log.csv");
+  ASSERT_EQ(past.code, 0) << past.err;
+  EXPECT_TRUE(contains(past.err,
+                       "the metrics window (t >= 10 s) holds none of the log's samples (t from 0 "
+                       "to 2.5 s)"))
+      << past.err;
+  const std::string row = past.out.substr(past.out.find("\nwindow "));
+  std::istringstream cells(row);
+  std::vector<std::string> cell;
+  for (std::string c; cells >> c && c != "->";) cell.push_back(c);
+  ASSERT_GE(cell.size(), 5u) << row;
+  EXPECT_EQ(cell[2], "-") << row;  // F RMS
+  EXPECT_EQ(cell[3], "-") << row;  // F max
+}
+
 // What `calibrate` says of the paper's log, whose push is held from t = 0 (not contact-free, as a
 // newcomer may try): the 2.5 s run is refused with numbers as people write them; on the whole
 // 6 s it warns, and its model check does not read joint 1's residual against the model's gravity
