@@ -69,6 +69,23 @@ ContactCount count_contacts(const fs::path& estimates) {
 
 bool have_gnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
+/// scenarios/NAME with its robot path made absolute (the copy is written elsewhere) and each
+/// (from, to) of `edits` replaced once; a `from` not found fails the test.
+std::string scenario_with(const std::string& name,
+                          const std::vector<std::pair<std::string, std::string>>& edits) {
+  std::string scenario = read_text(kSource / "scenarios" / name);
+  std::vector<std::pair<std::string, std::string>> all = {
+      {"robot: ../models/paper_arm.urdf",
+       "robot: " + (kSource / "models/paper_arm.urdf").string()}};
+  all.insert(all.end(), edits.begin(), edits.end());
+  for (const auto& [from, to] : all) {
+    const auto at = scenario.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) scenario.replace(at, from.size(), to);
+  }
+  return scenario;
+}
+
 // One short run of the paper scenario (through the singularity at t = 2 s) shared by the tests.
 class RealLog : public ::testing::Test {
  protected:
@@ -433,16 +450,8 @@ TEST_F(RealLog, CalibrateOnThePushedLogSaysWhatAPersonCanRead) {
                        "on 0 % of the samples"))
       << short_log.err;
 
-  std::string scenario = read_text(kSource / "scenarios" / "paper.yaml");
-  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
-           {"robot: ../models/paper_arm.urdf",
-            "robot: " + (kSource / "models/paper_arm.urdf").string()},
-           {"seeds: [1, 2, 3, 4, 5]", "seeds: [1]"}}) {
-    const auto at = scenario.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    scenario.replace(at, from.size(), to);
-  }
-  write_text(dir_ / "paper_6s.yaml", scenario);
+  write_text(dir_ / "paper_6s.yaml",
+             scenario_with("paper.yaml", {{"seeds: [1, 2, 3, 4, 5]", "seeds: [1]"}}));
   const CliRun sim = run("simulate --no-figures '" + (dir_ / "paper_6s.yaml").string() +
                          "' --out '" + (dir_ / "sim_6s").string() + "'");
   ASSERT_EQ(sim.code, 0) << sim.err;
@@ -466,16 +475,8 @@ TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
       fs::temp_directory_path() / ("extwrench_rehearsal_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  std::string scenario = read_text(kSource / "scenarios" / "paper_free_motion.yaml");
-  for (const auto& [from, to] : std::vector<std::pair<std::string, std::string>>{
-           {"robot: ../models/paper_arm.urdf",
-            "robot: " + (kSource / "models/paper_arm.urdf").string()},
-           {"duration: 60.0", "duration: 20.0"}}) {
-    const auto at = scenario.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    scenario.replace(at, from.size(), to);
-  }
-  write_text(dir / "free.yaml", scenario);
+  write_text(dir / "free.yaml",
+             scenario_with("paper_free_motion.yaml", {{"duration: 60.0", "duration: 20.0"}}));
   // Run in `dir`, as the commands in the scenario's header are.
   const auto cli = [&](const std::string& args) {
     return test::run_cli(EXTWRENCH_CLI, args, dir, "/dev/null", "cd '" + dir.string() + "' &&");
