@@ -93,20 +93,14 @@ class RealLog : public ::testing::Test {
     dir_ = fs::temp_directory_path() / ("extwrench_cli_replay_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    std::string scenario = read_text(kSource / "scenarios" / "paper.yaml");
-    const auto replace = [&](const std::string& from, const std::string& to) {
-      const auto at = scenario.find(from);
-      ASSERT_NE(at, std::string::npos) << from;
-      scenario.replace(at, from.size(), to);
-    };
-    replace("robot: ../models/paper_arm.urdf",
-            "robot: " + (kSource / "models/paper_arm.urdf").string());
-    replace("seeds: [1, 2, 3, 4, 5]", "seeds: [1]");
-    replace("duration: 6.0", "duration: 2.5");
-    // The paper's acceptance (docs/simulation.md) as the scenario's targets.
-    replace("  singularity_link: link6",
-            "  singularity_link: link6\n  targets: {ft: {force_rms: 1.0, line_rms: 0.02, "
-            "right_link: 99}, no_sensor: {force_rms_outside: 3.0}}");
+    std::string scenario = scenario_with(
+        "paper.yaml",
+        {{"seeds: [1, 2, 3, 4, 5]", "seeds: [1]"},
+         {"duration: 6.0", "duration: 2.5"},
+         // The paper's acceptance (docs/simulation.md) as the scenario's targets.
+         {"  singularity_link: link6",
+          "  singularity_link: link6\n  targets: {ft: {force_rms: 1.0, line_rms: 0.02, "
+          "right_link: 99}, no_sensor: {force_rms_outside: 3.0}}"}});
     write_text(dir_ / "paper_short.yaml", scenario);
     const CliRun r = run("simulate --no-figures '" + (dir_ / "paper_short.yaml").string() +
                          "' --out '" + (dir_ / "sim").string() + "'");
