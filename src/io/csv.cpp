@@ -220,9 +220,7 @@ void CsvReader::read_header() {
   // A robot file given where a CSV belongs (`--log arm.urdf`): say so, not "a quote inside an
   // unquoted cell" of its XML declaration. No header of column names begins with '<'.
   if (trim(line_).starts_with('<')) {
-    throw Error(where() +
-                "this is XML (a URDF or MJCF robot file?), but a CSV file begins with "
-                "a header row of column names");
+    throw Error(where() + xml_given_instead("a CSV file begins with a header row of column names"));
   }
   split_line();
   header_.assign(cells_.begin(), cells_.end());

@@ -85,4 +85,8 @@ std::string read_input_file(const std::filesystem::path& path, const std::string
   return text;
 }
 
+std::string xml_given_instead(const std::string& what_belongs) {
+  return "this is XML (a URDF or MJCF robot file?), but " + what_belongs;
+}
+
 }  // namespace extwrench

@@ -26,4 +26,9 @@ void check_input_file(const std::filesystem::path& path, const std::string& what
 std::string read_input_file(const std::filesystem::path& path, const std::string& what,
                             std::uintmax_t max_bytes = kMaxTextFileBytes);
 
+/// The message for a robot file given where a text file of another kind belongs (`--config
+/// arm.urdf`): "this is XML (a URDF or MJCF robot file?), but <what_belongs>". The readers
+/// prefix the file and line.
+std::string xml_given_instead(const std::string& what_belongs);
+
 }  // namespace extwrench

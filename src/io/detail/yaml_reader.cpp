@@ -49,9 +49,10 @@ YAML::Node load_yaml_file(const std::filesystem::path& path, const std::string& 
         std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(first), '\n') + 1;
     const bool names_robot = what == "configuration" || what == "scenario";
     const std::string kind = what == "robot" ? "DH robot table" : what;
-    throw Error(path.string() + ":" + std::to_string(line) +
-                ": this is XML (a URDF or MJCF robot file?), but a " + kind + " is YAML" +
-                (names_robot ? ", which names the robot file under 'robot:'" : ""));
+    throw Error(
+        path.string() + ":" + std::to_string(line) + ": " +
+        xml_given_instead("a " + kind + " is YAML" +
+                          (names_robot ? ", which names the robot file under 'robot:'" : "")));
   }
   return load_yaml_string(text, path.string());
 }
