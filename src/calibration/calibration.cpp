@@ -31,6 +31,9 @@ constexpr double kMadToSigma = 1.4826;  // σ of a Gaussian from its median abso
 constexpr double kSpeedGain = 0.95;
 // Above this share of the measured torque's RMS left in the calibrated residual: warned.
 constexpr double kMaxUnexplainedShare = 0.5;
+// No joint threshold below this [N m], in either form: an ideal simulated log's residual is
+// rounding, and a threshold fitted to rounding alarms on the next sample's.
+constexpr double kMinThreshold = 1e-6;
 
 void check_samples(const std::vector<Sample>& samples, int n, bool known_external_torque) {
   for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -199,7 +202,7 @@ void joint_threshold(const std::vector<double>& r, const std::vector<Sample>& sa
   const double fit_log = std::log(std::max(2.0 * j.crossing_rate * duration, 2.0));
   const double extrapolated = margin * peak * std::sqrt(std::max(target_log / fit_log, 1.0));
   j.threshold_from_max = extrapolated > gaussian;
-  j.threshold = std::max(std::max(gaussian, extrapolated), 1e-6);
+  j.threshold = std::max(std::max(gaussian, extrapolated), kMinThreshold);
 }
 
 // Thresholds that follow the speed: the spread of the residual as a line in |q̇|,
@@ -236,7 +239,7 @@ void speed_threshold(const std::vector<double>& r, const std::vector<double>& dq
     z[k] = r[k] / std::max(j.noise_at_rest + j.noise_per_speed * std::abs(dq[k]), 1e-12);
   JointFitReport zj;
   joint_threshold(z, samples, use, rate, margin, zj);
-  j.threshold_at_rest = zj.threshold * j.noise_at_rest;
+  j.threshold_at_rest = std::max(zj.threshold * j.noise_at_rest, kMinThreshold);
   j.threshold_per_speed = zj.threshold * j.noise_per_speed;
   double sum = 0.0;
   for (std::size_t k = 0; k < r.size(); ++k)

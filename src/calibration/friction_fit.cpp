@@ -373,8 +373,17 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
     best_with.condition = best_solve_with.condition;
     best = best_with;
   }
-  if (best.viscous == 0.0) best.warnings.push_back(j + ": viscous friction fitted < 0, set to 0");
-  if (best.coulomb == 0.0) best.warnings.push_back(j + ": Coulomb friction fitted < 0, set to 0");
+  // A sign fitted to rounding (an ideal simulated log) is not worth a warning.
+  double sum2 = 0.0, count = 0.0;
+  for (std::size_t k = 0; k < s.r0.size(); ++k) {
+    if (!use[k]) continue;
+    sum2 += s.r0[k] * s.r0[k];
+    count += 1.0;
+  }
+  if (count > 0.0 && std::sqrt(sum2 / count) >= kResolvableTorque) {
+    if (best.viscous == 0.0) best.warnings.push_back(j + ": viscous friction fitted < 0, set to 0");
+    if (best.coulomb == 0.0) best.warnings.push_back(j + ": Coulomb friction fitted < 0, set to 0");
+  }
   // The residual with the chosen friction, over the whole log.
   coulomb_regressor(s, options.sign, best.smoothing, best.shift, phi);
   filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);

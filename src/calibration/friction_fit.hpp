@@ -10,6 +10,12 @@
 
 namespace extwrench::calibration_detail {
 
+/// The smallest torque [N m] a calibration message is about: a model-check pattern that explains
+/// less, or a friction coefficient fitted below zero on a residual smaller than this, is not
+/// said. An ideal simulated log leaves ~1e-5 N m of integration error that follows q, q̇ and q̈
+/// as closely as a real error would, and no joint torque sensor resolves a milli-newton-metre.
+inline constexpr double kResolvableTorque = 1e-3;
+
 /// One joint's series over the log: q̇_k, the residual r⁰_k without friction, and the filter
 /// coefficient α_k = e^{−K Δt_k} of the step ending at sample k (α_0 unused). With a residual
 /// filter on the joint (observer.residual_cutoff), its weight per step (residual_filter.hpp;

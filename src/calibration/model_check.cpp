@@ -1,6 +1,7 @@
 #include "model_check.hpp"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -74,6 +75,11 @@ double variance(const std::vector<double>& x, const std::vector<char>& use) {
   return n < 2 ? 0.0 : sum2 / n - (sum / n) * (sum / n);
 }
 
+/// RMS of the part of y (over the used samples) that a fit with this R² explains.
+double explained_rms(double r2, const std::vector<double>& y, const std::vector<char>& use) {
+  return std::sqrt(std::max(r2, 0.0) * variance(y, use));
+}
+
 std::string num(double x) { return number_text(x, 3); }
 
 // "the robot's inertia along it is |δI| kg m^2 larger|smaller than the model's (why)".
@@ -110,7 +116,8 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
       phi[k] = s.dq[k] > 0 ? 1.0 : (s.dq[k] < 0 ? -1.0 : 0.0);
     filter_regressor(phi, s.alpha, z, s.filter_weight);
     const LineFit coulomb = fit_line(z, before[i].r0, use);
-    if (coulomb.r2 >= kJointShare) {
+    if (coulomb.r2 >= kJointShare &&
+        explained_rms(coulomb.r2, before[i].r0, use) >= kResolvableTorque) {
       check.patterns.push_back({"coulomb", joint, coulomb.r2,
                                 "joint " + std::to_string(joint) +
                                     ": the residual flips with sign(dq) (" +
@@ -119,7 +126,8 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     }
     // Lags the reversals: the same friction with the Dahl sign fits better (fit_joint).
     const DahlAlternative& dahl = after[i].dahl;
-    if (dahl.presliding > 0.0 && count > 0 && dahl.rss <= (1.0 - kMinDahlGain) * dahl.sign_rss) {
+    if (dahl.presliding > 0.0 && count > 0 && dahl.rss <= (1.0 - kMinDahlGain) * dahl.sign_rss &&
+        std::sqrt((dahl.sign_rss - dahl.rss) / count) >= kResolvableTorque) {
       check.patterns.push_back(
           {"presliding", joint, 1.0 - dahl.rss / dahl.sign_rss,
            "joint " + std::to_string(joint) +
@@ -133,7 +141,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     // Follows g(q): the calibrated residual against the filtered gravity torque.
     filter_regressor(s.gravity, s.alpha, z, s.filter_weight);
     const LineFit g = fit_line(z, after[i].residual, use);
-    if (g.r2 >= kJointShare) {
+    if (g.r2 >= kJointShare && explained_rms(g.r2, after[i].residual, use) >= kResolvableTorque) {
       // Beyond the model's own g_i (a real leg on a force plate: 14.5 times it at the knee) the
       // size alone says more than "a mass error", and a percentage of thousands reads as noise.
       const bool beyond = std::abs(g.slope) > 1.0;
@@ -165,7 +173,8 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
       // Beyond g(q): in a periodic motion the position, hence a gravity error, follows q̈ too.
       filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
       const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
-      if (inertia.extra_r2 >= kJointShare) {
+      if (inertia.extra_r2 >= kJointShare &&
+          explained_rms(inertia.extra_r2, after[i].residual, use) >= kResolvableTorque) {
         const double delta = -inertia.slope;
         const std::string follows = "joint " + std::to_string(joint) +
                                     ": the calibrated residual follows the joint's acceleration "
@@ -196,7 +205,8 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     std::vector<double> low = after[i].residual;
     apply_residual_filter(suggested, low);
     const double total = variance(after[i].residual, use), filtered = variance(low, use);
-    if (total > 0.0 && filtered <= kHighFrequencyLeft * total) {
+    if (total > 0.0 && filtered <= kHighFrequencyLeft * total &&
+        std::sqrt(total - filtered) >= kResolvableTorque) {
       const double share = 1.0 - filtered / total;
       check.patterns.push_back(
           {"high_frequency", joint, share,

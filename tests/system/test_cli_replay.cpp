@@ -522,6 +522,44 @@ TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
   fs::remove_all(dir);
 }
 
+// The same rehearsal made ideal (no friction, offsets, noise, quantisation or model error), where
+// tuning in simulation begins: the residual is the integration's rounding (~1e-5 N m and less).
+// Before, calibrate read that rounding as friction fitted below zero (9 warnings), and the wrist's
+// threshold that followed the speed was fitted to it (3e-16 N m at rest): 70 % of the held-out
+// samples false-alarmed.
+TEST(Rehearsal, AnIdealSimulationCalibratesQuietlyAndNamesNothing) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("extwrench_ideal_rehearsal_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string zeros = "[0, 0, 0, 0, 0, 0, 0]";
+  write_text(dir / "ideal.yaml",
+             scenario_with(
+                 "paper_free_motion.yaml",
+                 {{"duration: 60.0", "duration: 20.0"},
+                  {"model_error: 0.01", "model_error: 0"},
+                  {"base: {type: ft, force_noise: 0.1, moment_noise: 0.005}", "base: {type: ft}"},
+                  {"encoder: {resolution: 1.2e-5, velocity: differentiate, velocity_cutoff: 100}",
+                   "encoder: {}"},
+                  {"viscous: [0.8, 1.0, 0.6, 0.7, 0.3, 0.25, 0.2]", "viscous: " + zeros},
+                  {"coulomb: [0.9, 1.2, 0.7, 0.8, 0.4, 0.3, 0.25]", "coulomb: " + zeros},
+                  {"offset: [0.15, -0.2, 0.1, -0.05, 0.08, -0.12, 0.04]", "offset: " + zeros},
+                  {"    noise: 0.02", "    noise: 0"}}));
+  const auto cli = [&](const std::string& args) {
+    return test::run_cli(EXTWRENCH_CLI, args, dir, "/dev/null", "cd '" + dir.string() + "' &&");
+  };
+  const CliRun sim = cli("simulate --no-figures ideal.yaml --out ideal");
+  ASSERT_EQ(sim.code, 0) << sim.err;
+  const CliRun cal =
+      cli("calibrate --config ideal/ft/config.yaml --log ideal/log.csv --out ideal/calib.yaml "
+          "--holdout 0.4");
+  ASSERT_EQ(cal.code, 0) << cal.err;
+  EXPECT_TRUE(contains(cal.out, ": 0 false-alarm samples (0 %), uncalibrated 0,")) << cal.out;
+  EXPECT_TRUE(contains(cal.out, "    no recognisable model error\n")) << cal.out;
+  EXPECT_FALSE(contains(cal.err, "fitted < 0")) << cal.err;
+  fs::remove_all(dir);
+}
+
 // The real Panda's contact-free motion (../shared/realdata, skipped without it) as a user first
 // replays it, K = 50 and the README's filter: contacts come and go (issue 10: 22-86 % of the
 // samples on the defaults) and `estimate` says to calibrate; after `calibrate`, with the file
