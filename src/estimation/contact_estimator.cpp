@@ -557,9 +557,18 @@ void ContactEstimator::known_point_force(int link, WrenchFit& fit, std::uint32_t
   point_jacobian(model_, data_, link, X_WL.act(options_.contact.point_L), J_);
   Vector3 x;
   Matrix3 basis;
+  double damping = 0.0;
   const int rank =
-      min_norm_solve<3>(J_.topRows<3>(), link, tau_ext_, options_.solver.rank_tolerance, x, basis);
+      min_norm_solve<3>(J_.topRows<3>(), link, tau_ext_, options_.solver, x, basis, damping);
   if (rank == 0) return;
+  // The force at the point replaces case E's wrench: its own solve says whether it was damped.
+  fit.damping = damping;
+  fit.damped = damping > 0.0;
+  if (fit.damped) {
+    flags |= EstimateFlag::kIllConditioned;
+  } else {
+    flags &= ~EstimateFlag::kIllConditioned;
+  }
   fit.force_W = x;
   fit.partial = true;
   fit.point_force = true;

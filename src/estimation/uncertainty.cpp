@@ -27,20 +27,21 @@ bool damped_normal_inverse(const Eigen::MatrixBase<Derived>& J, int cols, double
   return true;
 }
 
-/// The pseudo-inverse of J Jᵀ (J: the first `cols` columns, R×n) on the observable subspace:
-/// Σ_k v_k v_kᵀ / (v_kᵀ J Jᵀ v_k) over the first `rank` columns v_k of `basis`, the eigenvectors
-/// min_norm_solve kept. P J τ̂ is the minimum-norm solution, so P stands for A⁻¹ in a partial fit.
+/// The (damped) pseudo-inverse of J Jᵀ (J: the first `cols` columns, R×n) on the observable
+/// subspace: Σ_k v_k v_kᵀ / (v_kᵀ J Jᵀ v_k + μ²) over the first `rank` columns v_k of `basis`, the
+/// eigenvectors min_norm_solve kept, μ² its damping. P J τ̂ is its solution, so P stands for A⁻¹
+/// in a partial fit.
 template <int R, typename Derived, typename Basis>
 Eigen::Matrix<double, R, R> observable_inverse(const Eigen::MatrixBase<Derived>& J, int cols,
-                                               const Eigen::MatrixBase<Basis>& basis,
-                                               int rank) noexcept {
+                                               const Eigen::MatrixBase<Basis>& basis, int rank,
+                                               double damping) noexcept {
   Eigen::Matrix<double, R, R> normal;
   normal.noalias() = J.leftCols(cols) * J.leftCols(cols).transpose();
   Eigen::Matrix<double, R, R> inverse = Eigen::Matrix<double, R, R>::Zero();
   for (int k = 0; k < rank; ++k) {
     const Eigen::Matrix<double, R, 1> v = basis.col(k);
     const double lambda = v.dot(normal * v);
-    if (lambda > 0.0) inverse.noalias() += (v / lambda) * v.transpose();
+    if (lambda > 0.0) inverse.noalias() += (v / (lambda + damping)) * v.transpose();
   }
   return inverse;
 }
@@ -70,8 +71,8 @@ Matrix6 force_sensor_case(const Matrix6X& J, int link, const WrenchFit& fit,
   Matrix6 out;
   Matrix3 inverse;
   if (fit.partial) {
-    inverse =
-        observable_inverse<3>(J.bottomRows<3>(), link, fit.basis_W.block<3, 3>(3, 3), fit.rank - 3);
+    inverse = observable_inverse<3>(J.bottomRows<3>(), link, fit.basis_W.block<3, 3>(3, 3),
+                                    fit.rank - 3, fit.damping);
   } else if (!damped_normal_inverse<3>(J.bottomRows<3>(), link, fit.damping, inverse)) {
     out.setConstant(kNaN);
     return out;
@@ -95,7 +96,7 @@ Matrix6 no_sensor_case(const Matrix6X& J, int link, const WrenchFit& fit,
                        const NoiseModel& noise) noexcept {
   Matrix6 inverse;
   if (fit.partial) {
-    inverse = observable_inverse<6>(J, link, fit.basis_W, fit.rank);
+    inverse = observable_inverse<6>(J, link, fit.basis_W, fit.rank, fit.damping);
   } else if (!damped_normal_inverse<6>(J, link, fit.damping, inverse)) {
     return Matrix6::Constant(kNaN);
   }
@@ -154,8 +155,10 @@ Matrix3 known_point_force_covariance(const Matrix6X& J_p, int link, const Wrench
                                      const NoiseModel& noise) noexcept {
   const auto J_v = J_p.topRows<3>();
   const Matrix3 inverse =
-      observable_inverse<3>(J_v, link, fit.basis_W.topLeftCorner<3, 3>(), fit.rank);
-  return inverse * weighted_gram<3>(J_v, link, noise.residual_variance) * inverse;
+      observable_inverse<3>(J_v, link, fit.basis_W.topLeftCorner<3, 3>(), fit.rank, fit.damping);
+  Matrix3 out = inverse * weighted_gram<3>(J_v, link, noise.residual_variance) * inverse;
+  if (fit.damping > 0.0) out += damping_bias<3>(inverse, fit.damping, fit.force_W.norm());
+  return out;
 }
 
 double point_force_misfit(const Matrix6X& J_p, int link, const VectorX& tau_ext,

@@ -1,11 +1,13 @@
 // The damped least-squares solver of cases D and E (Remark 6, damped_least_squares.hpp) on its
 // own, against Eigen's SVD: exact while κ ≤ max_condition, the damping law's solution (gain
-// along the weakest direction ≤ 1/ε) beyond, NaN and rank_ok false when rank deficient.
+// along the weakest direction ≤ 1/ε) beyond, NaN and rank_ok false when rank deficient; the
+// observable part of a rank-deficient system by the same law on its kept directions.
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
 #include <cmath>
+#include <limits>
 
 #include "extwrench/estimation/damped_least_squares.hpp"
 #include "support/test_robots.hpp"
@@ -108,6 +110,46 @@ TEST(DampedLeastSquares, RankDeficientSystemIsReportedAndGivesNaN) {
   const DlsInfo info = damped_solve<3>(J, 4, b, SolverOptions{}, x, guess);
   EXPECT_FALSE(info.rank_ok);
   EXPECT_TRUE(x.array().isNaN().all());
+}
+
+// The observable part (min_norm_solve) of a rank-deficient J (σ₃ = 0): the SVD's least-squares
+// solution on the kept directions, exact while they are well conditioned and damped by the same
+// law beyond (μ² = ε² − σ₂², gain ≤ 1/ε); before, it was undamped (gain 1/σ₂: 2e5 here).
+TEST(DampedLeastSquares, ObservablePartFollowsTheDampingLawOnTheKeptDirections) {
+  SeededRng rng(13);
+  SolverOptions opt;
+  opt.max_condition = 1e3;
+  for (const double s_2 : {0.4, 5e-4, 1e-5}) {
+    const Vector3 sigma(2.0, s_2, 0.0);
+    const auto J = with_singular_values<3>(sigma, 7, 4, rng);
+    const VectorX b = rng.uniform_vector(7, -3, 3);
+    Vector3 x;
+    Matrix3 basis;
+    double damping = -1.0;
+    const int rank = min_norm_solve<3>(J, 4, b, opt, x, basis, damping);
+    ASSERT_EQ(rank, 2) << "σ_2 = " << s_2;
+    // The SVD's: Σ_{i ≤ 2} u_i σ_i/(σ_i² + μ²) v_iᵀ b.
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J.leftCols(4),
+                                                Eigen::ComputeThinU | Eigen::ComputeThinV);
+    const VectorX s = svd.singularValues();
+    const double eps = s[0] / opt.max_condition;
+    const double mu2 = s[1] < eps ? eps * eps - s[1] * s[1] : 0.0;
+    const VectorX vb = svd.matrixV().transpose() * b.head(4);
+    Vector3 expected = Vector3::Zero();
+    for (int i = 0; i < 2; ++i)
+      expected += svd.matrixU().col(i) * (s[i] / (s[i] * s[i] + mu2) * vb[i]);
+    EXPECT_NEAR(damping, mu2, 1e-9 * eps * eps) << "σ_2 = " << s_2;
+    EXPECT_EQ(damping > 0.0, s_2 < 2.0 / opt.max_condition);
+    EXPECT_LT((x - expected).norm(), 1e-6 * expected.norm()) << "σ_2 = " << s_2;
+    EXPECT_LE(x.norm(), b.head(4).norm() * opt.max_condition / 2.0 * (1 + 1e-12));
+    // The basis spans the kept directions u_1, u_2: orthonormal, and normal to u_3.
+    const Eigen::Matrix<double, 3, 2> kept = basis.leftCols<2>();
+    const Vector3 u_3 = svd.matrixU().col(2);
+    EXPECT_LT((kept.transpose() * kept - Eigen::Matrix2d::Identity()).norm(), 1e-12);
+    // (An eigenvector of J Jᵀ is accurate to ~ε_machine λ_max / gap: the normal equations.)
+    const double gap = s_2 * s_2 / (sigma[0] * sigma[0]);
+    EXPECT_LT((kept.transpose() * u_3).norm(), 4 * std::numeric_limits<double>::epsilon() / gap);
+  }
 }
 
 TEST(DampedLeastSquares, LdltInPlaceSolvesLikeEigensLdlt) {

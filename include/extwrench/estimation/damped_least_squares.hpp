@@ -205,16 +205,20 @@ inline DlsInfo damped_solve(const Eigen::MatrixBase<Derived>& J, int cols, const
   return info;
 }
 
-/// The observable part of a rank-deficient J x = J b... system (J: R×n, first `cols` columns):
-/// with J Jᵀ = V Λ Vᵀ and the kept directions λ_i > (rank_tolerance · σ_max)², the minimum-norm
-/// solution x = Σ_kept v_i (v_iᵀ J b) / λ_i of Jᵀ x = b and the orthonormal basis of the kept
-/// directions (the first `rank` columns of `basis`). Components of x outside that subspace are
-/// not observable (zero here). Returns the rank (0: nothing observable, x zero). Fixed-size
-/// eigensolver: no allocation.
+/// The observable part of a rank-deficient Jᵀ x = b (J: R×n, first `cols` columns): with
+/// J Jᵀ = V Λ Vᵀ and the kept directions λ_i > (rank_tolerance · σ_max)², the least-squares
+/// solution of smallest norm on them, x = Σ_kept v_i (v_iᵀ J b) / (λ_i + μ²), and the orthonormal
+/// basis of the kept directions (the first `rank` columns of `basis`). μ² is damped_solve's law
+/// on the kept directions, λ_r the smallest: μ² = ε² − λ_r when λ_r < ε², ε = σ_max /
+/// max_condition, so the gain along the weakest kept direction stays ≤ 1/ε as in the full-rank
+/// case (a short chain near its own singularity: undamped, a 1 N m residual read as 10 kN).
+/// Components of x outside that subspace are not observable (zero here). Returns the rank (0:
+/// nothing observable, x zero); `damping` gets μ² (0: undamped). Fixed-size eigensolver: no
+/// allocation.
 template <int R, typename Derived, typename VectorB>
 inline int min_norm_solve(const Eigen::MatrixBase<Derived>& J, int cols, const VectorB& b,
-                          double rank_tolerance, Eigen::Matrix<double, R, 1>& x,
-                          Eigen::Matrix<double, R, R>& basis) noexcept {
+                          const SolverOptions& opt, Eigen::Matrix<double, R, 1>& x,
+                          Eigen::Matrix<double, R, R>& basis, double& damping) noexcept {
   using MatR = Eigen::Matrix<double, R, R>;
   using VecR = Eigen::Matrix<double, R, 1>;
   MatR A;
@@ -222,15 +226,20 @@ inline int min_norm_solve(const Eigen::MatrixBase<Derived>& J, int cols, const V
   detail::normal_equations<R>(J, cols, b, A, y);
   const Eigen::SelfAdjointEigenSolver<MatR> eig(A);
   const VecR& lambda = eig.eigenvalues();  // increasing
-  const double floor = rank_tolerance * rank_tolerance * std::max(lambda[R - 1], 0.0);
+  const double l_max = std::max(lambda[R - 1], 0.0);
+  const double floor = opt.rank_tolerance * opt.rank_tolerance * l_max;
   x.setZero();
   basis.setZero();
-  int rank = 0;
+  damping = 0.0;
   if (!(lambda[R - 1] > 0.0) || eig.info() != Eigen::Success) return 0;
-  for (int i = R - 1; i >= 0; --i) {
-    if (!(lambda[i] > floor)) break;
+  int first_kept = R - 1;
+  while (first_kept > 0 && lambda[first_kept - 1] > floor) --first_kept;
+  const double eps2 = l_max / (opt.max_condition * opt.max_condition);  // ε²
+  if (lambda[first_kept] < eps2) damping = eps2 - lambda[first_kept];
+  int rank = 0;
+  for (int i = R - 1; i >= first_kept; --i) {
     const VecR v = eig.eigenvectors().col(i);
-    x += v * (v.dot(y) / lambda[i]);
+    x += v * (v.dot(y) / (lambda[i] + damping));
     basis.col(rank++) = v;
   }
   return rank;

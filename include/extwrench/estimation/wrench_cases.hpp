@@ -22,10 +22,10 @@ struct WrenchFit {
   Vector3 force_W = Vector3::Constant(std::numeric_limits<double>::quiet_NaN());  ///< F̂
   Vector3 moment_O = Vector3::Constant(std::numeric_limits<double>::quiet_NaN());  ///< M̄, about O_l
   bool ok = false;            ///< (F̂, M̄) estimated
-  bool damped = false;        ///< damped least squares active (cases D, E)
+  bool damped = false;        ///< damped least squares active (cases D, E; partial too)
   bool fitted_force = false;  ///< F̂ comes from the fit (case E), not the sensor
   double condition = std::numeric_limits<double>::quiet_NaN();  ///< κ of the inverted Jacobian
-  double damping = 0.0;  ///< μ² of the damped solve (cases D, E); 0 when undamped
+  double damping = 0.0;  ///< μ² of the damped solve (cases D, E; partial too); 0 when undamped
   /// Rank test failed (cases D, E): force_W / moment_O hold the minimum-norm solution on the
   /// observable subspace (ok stays false: no line of action), basis_W its orthonormal basis in
   /// (F; M̄) coordinates, first `rank` columns.
@@ -39,12 +39,14 @@ struct WrenchFit {
 
 /// Case D's observable part: the sensor's force (all of F) and the observable moment directions.
 template <typename Jacobian>
-inline void partial_moment(const Jacobian& J, int link, const VectorX& b, double rank_tolerance,
-                           WrenchFit& fit) noexcept {
+inline void partial_moment(const Jacobian& J, int link, const VectorX& b,
+                           const SolverOptions& solver, WrenchFit& fit) noexcept {
   Vector3 x;
   Matrix3 basis;
-  const int r = min_norm_solve<3>(J.template bottomRows<3>(), link, b, rank_tolerance, x, basis);
+  const int r =
+      min_norm_solve<3>(J.template bottomRows<3>(), link, b, solver, x, basis, fit.damping);
   fit.moment_O = x;
+  fit.damped = fit.damping > 0.0;
   fit.partial = true;
   fit.basis_W.setZero();
   fit.basis_W.template topLeftCorner<3, 3>().setIdentity();
@@ -55,10 +57,11 @@ inline void partial_moment(const Jacobian& J, int link, const VectorX& b, double
 /// Case E's observable part: the minimum-norm wrench (F̂; M̄) on the observable subspace.
 template <typename Jacobian>
 inline void partial_wrench(const Jacobian& J, int link, const VectorX& tau_ext,
-                           double rank_tolerance, WrenchFit& fit) noexcept {
+                           const SolverOptions& solver, WrenchFit& fit) noexcept {
   Vector6 x;
   Eigen::Matrix<double, 6, 6> basis;
-  fit.rank = min_norm_solve<6>(J, link, tau_ext, rank_tolerance, x, basis);
+  fit.rank = min_norm_solve<6>(J, link, tau_ext, solver, x, basis, fit.damping);
+  fit.damped = fit.damping > 0.0;
   fit.force_W = x.head<3>();
   fit.moment_O = x.tail<3>();
   fit.basis_W = basis;
@@ -105,7 +108,7 @@ inline void fit_wrench_case(WrenchFit& fit, SensorType type, const Jacobian& J, 
       fit.damped = info.damped;
       fit.damping = info.damping;
     } else if (observable_part && link > 0 && base.force_W.allFinite()) {
-      partial_moment(J, link, b, solver.rank_tolerance, fit);
+      partial_moment(J, link, b, solver, fit);
     }
   } else {
     // E (27): W̄ = (J_lᵀ)# τ̂_1:l, rank J_l = 6 required.
@@ -120,7 +123,7 @@ inline void fit_wrench_case(WrenchFit& fit, SensorType type, const Jacobian& J, 
       fit.damping = info.damping;
       fit.fitted_force = true;
     } else if (observable_part && link > 0) {
-      partial_wrench(J, link, tau_ext, solver.rank_tolerance, fit);
+      partial_wrench(J, link, tau_ext, solver, fit);
       fit.fitted_force = fit.rank > 0;
     }
   }
