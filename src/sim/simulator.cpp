@@ -129,7 +129,7 @@ void Simulator::add_joint_torque_terms(VectorX& tau) noexcept {
 bool Simulator::next(Sample& out) {
   if (k_ >= num_samples_) return false;
   const int n = model_.nq();
-  const double t = static_cast<double>(k_) * config_.sample_time;
+  const double t = sample_instant(k_, config_.sample_time);
   joint_sensor_.measure(t, q_, dq_, qm_, dqm_);
   const VectorX& tau = controller_.update(t, qm_, dqm_);
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "calibration/calibration_sim.hpp"
@@ -385,6 +387,29 @@ TEST(Controller, IntegralTermRecoversThePathUnderAConstantForce) {
   }
   EXPECT_GT(peak, 1e-3);
   EXPECT_LT(last, 0.01 * peak);
+}
+
+// The log's t is the decimal a person expects: at 1 kHz sample 9 is at 0.009, not at
+// 9 × 0.001 = 0.009000000000000001 (14 % of a minute's rows were written so). A rate that is not a
+// whole number of hertz keeps k · sample_time.
+TEST(Simulator, SampleInstantsAreTheDecimalsOfAWholeRate) {
+  const Model model = random_chain({.n = 3, .seed = 51});
+  SinusoidalTrajectory tr = small_sinusoid(3);
+  ComputedTorqueController ctl(model, tr, pid_gains_triple_pole(3, 10.0));
+  SimulationConfig cfg;
+  cfg.duration = 1.0;
+  Simulator sim(model, ctl, cfg);
+  Sample s;
+  long k = 0;
+  while (sim.next(s)) {
+    char decimal[32];
+    std::snprintf(decimal, sizeof decimal, "%ld.%03ld", k / 1000, k % 1000);
+    ASSERT_EQ(s.t, std::strtod(decimal, nullptr)) << decimal;
+    ++k;
+  }
+  EXPECT_EQ(k, 1001);
+  EXPECT_EQ(sample_instant(9, 0.0007), 9 * 0.0007);  // 1428.57... Hz
+  EXPECT_EQ(sample_instant(3, 0.002), 0.006);        // 500 Hz
 }
 
 TEST(Simulator, BaseReadingEqualsWeightPlusForceForARobotHeldAtRest) {

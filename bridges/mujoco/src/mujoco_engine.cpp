@@ -327,7 +327,7 @@ void MujocoSimulator::apply_forces(double t, const VectorX& q) {
 bool MujocoSimulator::next(Sample& out) {
   if (k_ >= num_samples_) return false;
   const int n = model_.nq();
-  const double t = static_cast<double>(k_) * config_.sample_time;
+  const double t = sim::sample_instant(k_, config_.sample_time);
   for (int i = 0; i < n; ++i) {
     q_[i] = d_->qpos[qpos_adr_[static_cast<std::size_t>(i)]];
     dq_[i] = d_->qvel[dof_adr_[static_cast<std::size_t>(i)]];

@@ -1,6 +1,7 @@
 // Closed-loop simulation of the true robot: RK4 at a fixed step, torque held between samples.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -13,7 +14,7 @@
 namespace extwrench::sim {
 
 struct SimulationConfig {
-  double duration = 6.0;  ///< [s]; samples at t = k · sample_time for k · sample_time <= duration
+  double duration = 6.0;      ///< [s]; samples at t = sample_instant(k, sample_time) <= duration
   double sample_time = 1e-3;  ///< controller and logging period [s]
   int substeps = 1;           ///< RK4 steps per sample (integration step = sample_time / substeps)
   std::vector<ForceProfile> forces;
@@ -24,6 +25,17 @@ struct SimulationConfig {
   /// Initial state; empty: the desired trajectory's q_d(0), q̇_d(0).
   VectorX q0, dq0;
 };
+
+/// The instant of sample k [s]: k / rate when the rate 1 / sample_time is a whole number of
+/// hertz (1 kHz: t = 0.009, the double nearest the decimal, where 9 × 0.001 writes
+/// 0.009000000000000001 into the log), else k · sample_time.
+inline double sample_instant(long k, double sample_time) noexcept {
+  const double rate = 1.0 / sample_time;
+  const double whole = std::round(rate);
+  return whole >= 1.0 && std::abs(rate - whole) <= 1e-9 * whole
+             ? static_cast<double>(k) / whole
+             : static_cast<double>(k) * sample_time;
+}
 
 /// Workspace of one RK4 step (sized once for a model).
 struct Rk4Workspace {
