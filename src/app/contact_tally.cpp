@@ -76,10 +76,12 @@ std::string frequent_alarms_note(const ContactTally& tally) {
   constexpr int kMinLinks = 3;
   if (tally.rows == 0 || tally.contact_samples == 0) return {};
   const double share = static_cast<double>(tally.contact_samples) / static_cast<double>(tally.rows);
-  int links = 0;
-  for (const long count : tally.samples_by_link)
+  int links = 0, links_named = 0;  // with kLinkShare of the samples, and with any (as listed)
+  for (const long count : tally.samples_by_link) {
     if (static_cast<double>(count) >= kLinkShare * static_cast<double>(tally.contact_samples))
       ++links;
+    if (count > 0) ++links_named;
+  }
   const bool frequent =
       tally.contact_episodes >= kMinEpisodes &&
       static_cast<double>(tally.contact_episodes) >= kMinEpisodesPerSecond * tally.duration();
@@ -89,7 +91,7 @@ std::string frequent_alarms_note(const ContactTally& tally) {
   std::snprintf(text, sizeof text,
                 "contact declared on %.0f %% of the samples, %ld time%s in %.1f s, on %d links",
                 100.0 * share, tally.contact_episodes, tally.contact_episodes == 1 ? "" : "s",
-                tally.duration(), links);
+                tally.duration(), links_named);
   return std::string(text) +
          ": what a robot moving freely shows when its thresholds lie below what its model misses "
          "(friction, torque offsets, noise). If nothing touched the robot, calibrate on a "
