@@ -2,6 +2,7 @@
 // element (MuJoCo's element and line, or our body/joint/geom), never a crash; and load_robot
 // reads MJCF once the reader is registered.
 #include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
 
 #include <fstream>
 #include <string>
@@ -76,6 +77,23 @@ TEST_F(MjcfMalformed, NotXmlNamesTheFileAndLine) {
 TEST_F(MjcfMalformed, UnknownElementNamesTheElementAndLine) {
   const std::string path = write("unknown.xml", arm("<joint name=\"j1\"/>", "<bogus/>"));
   EXPECT_TRUE(has_all(error_of(path), {path, "bogus", "line"}));
+}
+
+// The MuJoCo Menagerie's current Panda is written for MuJoCo >= 2.3.3: on Debian's 2.2.2 its
+// integrator="implicitfast" was "invalid keyword" without a word of why.
+TEST_F(MjcfMalformed, AWordOfANewerMujocoSaysSo) {
+  const std::string keyword =
+      write("newer.xml", "<mujoco model=\"m\">\n<option integrator=\"implicitfast\"/>\n" +
+                             arm().substr(std::string("<mujoco model=\"m\">\n").size()));
+  EXPECT_TRUE(has_all(error_of(keyword), {keyword, "invalid keyword", "line 2",
+                                          std::string("this MuJoCo is ") + mj_versionString(),
+                                          "newer one", "docs/mujoco.md"}));
+  const std::string attribute =
+      write("kv.xml", arm("<joint name=\"j1\"/>", "<geom size=\"0.05\" kv=\"3\"/>"));
+  EXPECT_TRUE(has_all(error_of(attribute), {attribute, "'kv'", "newer one"}));
+  // A malformed file that no MuJoCo reads gets no such hint.
+  const std::string broken = write("cut.xml", "<mujoco>\n<worldbody>\n<body name=\"a\">\n");
+  EXPECT_EQ(error_of(broken).find("newer one"), std::string::npos);
 }
 
 TEST_F(MjcfMalformed, BadNumberNamesTheAttribute) {

@@ -27,6 +27,20 @@ std::string one_line(std::string text) {
   return text;
 }
 
+// MuJoCo's error, and for a word its schema does not know the likely cause: a file written for a
+// newer MuJoCo (the MuJoCo Menagerie's current Panda: integrator="implicitfast", `kv`).
+std::string rejection(const std::string& name, const char* error) {
+  std::string text = name + ": MuJoCo rejects the MJCF: " + one_line(error);
+  if (std::strstr(error, "invalid keyword") != nullptr ||
+      std::strstr(error, "unrecognized attribute") != nullptr ||
+      std::strstr(error, "unrecognized element") != nullptr) {
+    text += std::string(" (this MuJoCo is ") + mj_versionString() +
+            ": a file written for a newer one can use words it does not know; replace them, "
+            "e.g. integrator=\"implicitfast\" by \"implicit\" (docs/mujoco.md))";
+  }
+  return text;
+}
+
 // The warning handler is global in MuJoCo: one load at a time swaps it.
 std::mutex g_load_mutex;
 void ignore_warning(const char* /*message*/) {}
@@ -40,7 +54,7 @@ std::unique_ptr<mjModel, ModelDeleter> compile(const std::string& path, const mj
   char error[2048] = "";
   std::unique_ptr<mjModel, ModelDeleter> m(mj_loadXML(path.c_str(), vfs, error, sizeof error));
   mju_user_warning = previous;
-  if (!m) throw Error(name + ": MuJoCo rejects the MJCF: " + one_line(error));
+  if (!m) throw Error(rejection(name, error));
   return m;
 }
 
