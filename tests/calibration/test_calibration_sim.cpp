@@ -324,12 +324,18 @@ bool has(const std::vector<std::string>& v, const char* kind) {
   return std::find(v.begin(), v.end(), kind) != v.end();
 }
 
-TEST(ModelCheckSim, CleanRunNamesNothing) {
-  const Model model = paper_arm();
+/// The paper arm's friction model with every coefficient and offset zero.
+test::TrueFriction no_friction() {
   test::TrueFriction none = test::paper_arm_friction();
   none.viscous.setZero();
   none.coulomb.setZero();
   none.offset.setZero();
+  return none;
+}
+
+TEST(ModelCheckSim, CleanRunNamesNothing) {
+  const Model model = paper_arm();
+  const test::TrueFriction none = no_friction();
   const auto log = test::simulate_free_motion(model, test::free_motion(0.0, 1.0), none, 20.0,
                                               Vector6::Zero(), kTauNoise, 41);
   const Calibration cal = calibrate(model, ft_options(), log);
@@ -344,10 +350,7 @@ TEST(ModelCheckSim, CleanRunNamesNothing) {
 // ideal rehearsal (test_cli_replay.cpp) shows what its thresholds did.
 TEST(ModelCheckSim, AnIdealLogNamesNothingAndItsThresholdsStayQuiet) {
   const Model model = paper_arm();
-  test::TrueFriction none = test::paper_arm_friction();
-  none.viscous.setZero();
-  none.coulomb.setZero();
-  none.offset.setZero();
+  const test::TrueFriction none = no_friction();
   const auto fit_log = test::simulate_free_motion(model, test::free_motion(0.0, 1.0), none, 20.0,
                                                   Vector6::Zero(), 0.0, 47);
   EstimatorOptions options = ft_options();  // as scenarios/paper_free_motion.yaml

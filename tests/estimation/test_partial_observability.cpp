@@ -58,16 +58,21 @@ VectorX planar_torques(const VectorX& q, double h, const Vector3& F, Vector3& p_
   return tau;
 }
 
-TEST(PartialObservability, PlanarChainWithAKnownPointGetsItsInPlaneForce) {
-  const Model model = planar_two_link();
-  ASSERT_EQ(model.nq(), 2);
+/// No sensor, the contact at (kL2, 0, 0.05) of link 2 (known), declared on the first sample.
+EstimatorOptions known_point_options() {
   EstimatorOptions opt;
   opt.sensor.type = SensorType::kNone;
   opt.contact.model = ContactModel::kKnownPoint;
   opt.contact.link = 2;
   opt.contact.point_L = Vector3(kL2, 0, 0.05);
   opt.detection.min_duration = 0.0;
-  ContactEstimator est(model, GeometryModel{}, opt);
+  return opt;
+}
+
+TEST(PartialObservability, PlanarChainWithAKnownPointGetsItsInPlaneForce) {
+  const Model model = planar_two_link();
+  ASSERT_EQ(model.nq(), 2);
+  ContactEstimator est(model, GeometryModel{}, known_point_options());
   const VectorX zero = VectorX::Zero(2);
   double t = 0.0, worst = 0.0;
   for (int k = 0; k < 50; ++k) {
@@ -108,12 +113,7 @@ TEST(PartialObservability, PlanarChainWithAKnownPointGetsItsInPlaneForce) {
 // Jacobian written by hand, bounded by ‖τ‖ κ_max / σ_max, and flagged ill-conditioned there.
 TEST(PartialObservability, KnownPointForceIsDampedTowardsTheStretchedArm) {
   const Model model = planar_two_link();
-  EstimatorOptions opt;
-  opt.sensor.type = SensorType::kNone;
-  opt.contact.model = ContactModel::kKnownPoint;
-  opt.contact.link = 2;
-  opt.contact.point_L = Vector3(kL2, 0, 0.05);
-  opt.detection.min_duration = 0.0;
+  const EstimatorOptions opt = known_point_options();
   const double max_condition = opt.solver.max_condition;
   const VectorX zero = VectorX::Zero(2);
   const Vector3 F(5.0, 8.0, 0.0);
