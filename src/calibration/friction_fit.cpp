@@ -57,6 +57,8 @@ struct Solve {
   Vec theta = Vec::Zero();
   double rss = std::numeric_limits<double>::infinity();
   double condition = 1.0;
+  double rr = 0.0,
+         count = 0.0;  ///< the residual's sum of squares without friction, and its samples
 };
 
 template <int C>
@@ -66,9 +68,10 @@ Solve<C> solve(const std::array<const std::vector<double>*, C>& z, const std::ve
   using Vec = Eigen::Matrix<double, C, 1>;
   Mat G = Mat::Zero();
   Vec b = Vec::Zero();
-  double rr = 0.0;
+  double rr = 0.0, count = 0.0;
   for (std::size_t k = 0; k < r0.size(); ++k) {
     if (!use[k]) continue;
+    count += 1.0;
     Vec zk;
     for (int c = 0; c < C; ++c) zk[c] = (*z[static_cast<std::size_t>(c)])[k];
     G.noalias() += zk * zk.transpose();
@@ -76,6 +79,8 @@ Solve<C> solve(const std::array<const std::vector<double>*, C>& z, const std::ve
     rr += r0[k] * r0[k];
   }
   Solve<C> out;
+  out.rr = rr;
+  out.count = count;
   Vec scale = Vec::Zero();
   for (int c = 0; c < C; ++c)
     scale[c] = active[static_cast<std::size_t>(c)] && G(c, c) > 0 ? 1.0 / std::sqrt(G(c, c)) : 0.0;
@@ -374,13 +379,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
     best = best_with;
   }
   // A sign fitted to rounding (an ideal simulated log) is not worth a warning.
-  double sum2 = 0.0, count = 0.0;
-  for (std::size_t k = 0; k < s.r0.size(); ++k) {
-    if (!use[k]) continue;
-    sum2 += s.r0[k] * s.r0[k];
-    count += 1.0;
-  }
-  if (count > 0.0 && std::sqrt(sum2 / count) >= kResolvableTorque) {
+  if (best_solve.count > 0.0 && std::sqrt(best_solve.rr / best_solve.count) >= kResolvableTorque) {
     if (best.viscous == 0.0) best.warnings.push_back(j + ": viscous friction fitted < 0, set to 0");
     if (best.coulomb == 0.0) best.warnings.push_back(j + ": Coulomb friction fitted < 0, set to 0");
   }

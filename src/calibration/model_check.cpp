@@ -75,10 +75,8 @@ double variance(const std::vector<double>& x, const std::vector<char>& use) {
   return n < 2 ? 0.0 : sum2 / n - (sum / n) * (sum / n);
 }
 
-/// RMS of the part of y (over the used samples) that a fit with this R² explains.
-double explained_rms(double r2, const std::vector<double>& y, const std::vector<char>& use) {
-  return std::sqrt(std::max(r2, 0.0) * variance(y, use));
-}
+/// RMS of the part of a series of this variance that a fit with this R² explains.
+double explained_rms(double r2, double variance) { return std::sqrt(std::max(r2, 0.0) * variance); }
 
 std::string num(double x) { return number_text(x, 3); }
 
@@ -117,7 +115,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     filter_regressor(phi, s.alpha, z, s.filter_weight);
     const LineFit coulomb = fit_line(z, before[i].r0, use);
     if (coulomb.r2 >= kJointShare &&
-        explained_rms(coulomb.r2, before[i].r0, use) >= kResolvableTorque) {
+        explained_rms(coulomb.r2, coulomb.syy / coulomb.count) >= kResolvableTorque) {
       check.patterns.push_back({"coulomb", joint, coulomb.r2,
                                 "joint " + std::to_string(joint) +
                                     ": the residual flips with sign(dq) (" +
@@ -139,9 +137,10 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
                " N m (docs/calibration.md, the Dahl sign)"});
     }
     // Follows g(q): the calibrated residual against the filtered gravity torque.
+    const double residual_variance = variance(after[i].residual, use);
     filter_regressor(s.gravity, s.alpha, z, s.filter_weight);
     const LineFit g = fit_line(z, after[i].residual, use);
-    if (g.r2 >= kJointShare && explained_rms(g.r2, after[i].residual, use) >= kResolvableTorque) {
+    if (g.r2 >= kJointShare && explained_rms(g.r2, residual_variance) >= kResolvableTorque) {
       // Beyond the model's own g_i (a real leg on a force plate: 14.5 times it at the knee) the
       // size alone says more than "a mass error", and a percentage of thousands reads as noise.
       const bool beyond = std::abs(g.slope) > 1.0;
@@ -174,7 +173,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
       filter_regressor(acc, s.alpha, z_acc, s.filter_weight);
       const SecondRegressor inertia = fit_beyond(after[i].residual, z, z_acc, use);
       if (inertia.extra_r2 >= kJointShare &&
-          explained_rms(inertia.extra_r2, after[i].residual, use) >= kResolvableTorque) {
+          explained_rms(inertia.extra_r2, residual_variance) >= kResolvableTorque) {
         const double delta = -inertia.slope;
         const std::string follows = "joint " + std::to_string(joint) +
                                     ": the calibrated residual follows the joint's acceleration "
@@ -204,7 +203,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     if (residual_cutoff[static_cast<Eigen::Index>(i)] > 0.0) continue;
     std::vector<double> low = after[i].residual;
     apply_residual_filter(suggested, low);
-    const double total = variance(after[i].residual, use), filtered = variance(low, use);
+    const double total = residual_variance, filtered = variance(low, use);
     if (total > 0.0 && filtered <= kHighFrequencyLeft * total &&
         std::sqrt(total - filtered) >= kResolvableTorque) {
       const double share = 1.0 - filtered / total;

@@ -86,6 +86,19 @@ std::string scenario_with(const std::string& name,
   return scenario;
 }
 
+/// An empty directory of the temp directory, `stem` + this process's id.
+fs::path fresh_dir(const std::string& stem) {
+  const fs::path dir = fs::temp_directory_path() / (stem + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// The CLI run from `dir`, as a user runs the commands with relative paths there.
+CliRun run_in(const fs::path& dir, const std::string& args) {
+  return test::run_cli(EXTWRENCH_CLI, args, dir, "/dev/null", "cd '" + dir.string() + "' &&");
+}
+
 // One short run of the paper scenario (through the singularity at t = 2 s) shared by the tests.
 class RealLog : public ::testing::Test {
  protected:
@@ -465,16 +478,11 @@ TEST_F(RealLog, CalibrateOnThePushedLogSaysWhatAPersonCanRead) {
 // logged torques carry friction and offsets), calibrate identifies the friction the scenario put
 // in them within 5 % and leaves the held-out 40 % quiet.
 TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("extwrench_rehearsal_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("extwrench_rehearsal_");
   write_text(dir / "free.yaml",
              scenario_with("paper_free_motion.yaml", {{"duration: 60.0", "duration: 20.0"}}));
   // Run in `dir`, as the commands in the scenario's header are.
-  const auto cli = [&](const std::string& args) {
-    return test::run_cli(EXTWRENCH_CLI, args, dir, "/dev/null", "cd '" + dir.string() + "' &&");
-  };
+  const auto cli = [&](const std::string& args) { return run_in(dir, args); };
   const CliRun sim = cli("simulate --no-figures free.yaml --out free");
   ASSERT_EQ(sim.code, 0) << sim.err;
   // The base sensor sees no contact where the residual sees friction: the warning names it.
@@ -528,10 +536,7 @@ TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
 // threshold that followed the speed was fitted to it (3e-16 N m at rest): 70 % of the held-out
 // samples false-alarmed.
 TEST(Rehearsal, AnIdealSimulationCalibratesQuietlyAndNamesNothing) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("extwrench_ideal_rehearsal_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("extwrench_ideal_rehearsal_");
   const std::string zeros = "[0, 0, 0, 0, 0, 0, 0]";
   write_text(dir / "ideal.yaml",
              scenario_with(
@@ -545,9 +550,7 @@ TEST(Rehearsal, AnIdealSimulationCalibratesQuietlyAndNamesNothing) {
                   {"coulomb: [0.9, 1.2, 0.7, 0.8, 0.4, 0.3, 0.25]", "coulomb: " + zeros},
                   {"offset: [0.15, -0.2, 0.1, -0.05, 0.08, -0.12, 0.04]", "offset: " + zeros},
                   {"    noise: 0.02", "    noise: 0"}}));
-  const auto cli = [&](const std::string& args) {
-    return test::run_cli(EXTWRENCH_CLI, args, dir, "/dev/null", "cd '" + dir.string() + "' &&");
-  };
+  const auto cli = [&](const std::string& args) { return run_in(dir, args); };
   const CliRun sim = cli("simulate --no-figures ideal.yaml --out ideal");
   ASSERT_EQ(sim.code, 0) << sim.err;
   const CliRun cal =
@@ -567,18 +570,13 @@ TEST(Rehearsal, AnIdealSimulationCalibratesQuietlyAndNamesNothing) {
 TEST(RealPanda, EstimateSaysToCalibrateOnTheUncalibratedFreeMotionOnly) {
   const fs::path data = fs::path(EXTWRENCH_SHARED_DIR) / "realdata/franka_panda_free_motion";
   if (!fs::exists(data / "log.csv")) GTEST_SKIP() << "../shared/realdata is absent";
-  const fs::path dir =
-      fs::temp_directory_path() / ("extwrench_real_panda_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("extwrench_real_panda_");
   const std::string robot = "robot: " + (data / "panda.urdf").string() +
                             "\nsensor: {type: none}\n"
                             "observer: {gain: 50, residual_cutoff: [20, 20, 20, 20, 0, 0, 0]}\n";
   write_text(dir / "panda.yaml", robot);
   write_text(dir / "calibrated.yaml", robot + "calibration: calib.yaml\n");
-  const auto cli = [&](const std::string& args) {
-    return test::run_cli(EXTWRENCH_CLI, args, dir, "/dev/null", "cd '" + dir.string() + "' &&");
-  };
+  const auto cli = [&](const std::string& args) { return run_in(dir, args); };
   const std::string log = " --log '" + (data / "log.csv").string() + "'";
   const CliRun plain = cli("estimate --no-figures --config panda.yaml" + log + " --out plain");
   ASSERT_EQ(plain.code, 0) << plain.err;
