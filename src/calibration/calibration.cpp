@@ -6,6 +6,7 @@
 #include <string>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
@@ -343,6 +344,19 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
   }
 }
 
+// (B(q_k) q̇_k)_i along the log: the model check compares the residual's fast part with what the
+// observer's momentum passes of the measured velocity's.
+void momentum_series(const Model& model, const std::vector<Sample>& samples,
+                     std::vector<JointSeries>& series) {
+  Data data(model);
+  for (JointSeries& js : series) js.momentum.assign(samples.size(), 0.0);
+  for (std::size_t k = 0; k < samples.size(); ++k) {
+    const VectorX p = crba(model, data, samples[k].q) * samples[k].dq;
+    for (std::size_t i = 0; i < series.size(); ++i)
+      series[i].momentum[k] = p[static_cast<Eigen::Index>(i)];
+  }
+}
+
 // g_i(q_k) along the log (the model check's gravity pattern), and the gravity torques of a unit
 // mass at the last link's origin and of unit first moments along its axes (a payload's, linear
 // in m and m c): with g_i, the nuisance regressors that keep the inertia fit from taking a
@@ -568,6 +582,7 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   }
 
   gravity_series(m, samples, o.inertia_correction, series);
+  momentum_series(m, samples, series);
   cal.observer_gain = gains;
   cal.residual_cutoff = per_joint(options.residual_cutoff, n);
   // The residual filter: every series from here on is the filtered residual (r is linear in θ,

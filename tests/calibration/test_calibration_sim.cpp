@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -491,6 +492,43 @@ TEST(ModelCheckSim, NamesARotorInertiaTheModelLacks) {
     EXPECT_LT(cal.joints[static_cast<std::size_t>(i)].rms_after,
               0.5 * uncorrected.joints[static_cast<std::size_t>(i)].rms_after);
   }
+}
+
+// Noise on the measured velocity that the torque does not see (a differentiated encoder's, a
+// drive's velocity estimate): the observer's momentum B(q) q̇ passes it as K B(q) δq̇, and no
+// friction or parameter fit can take it out. Added here to a clean log's q̇ after the simulation
+// (white, 2 mrad/s): the check names it on the heavy proximal joints, with the slope 1 of a
+// velocity error (the message's), and says so in `high_frequency` too; the torque noise alone
+// names neither (CleanRunNamesNothing).
+TEST(ModelCheckSim, NamesTheVelocitysNoiseThroughTheObserversMomentum) {
+  const Model model = paper_arm();
+  auto log = test::simulate_free_motion(model, test::free_motion(0.0, 1.0), no_friction(), 20.0,
+                                        Vector6::Zero(), kTauNoise, 61);
+  std::mt19937_64 rng(61);
+  std::normal_distribution<double> velocity_noise(0.0, 0.002);
+  for (Sample& s : log)
+    for (Eigen::Index i = 0; i < s.dq.size(); ++i) s.dq[i] += velocity_noise(rng);
+  const Calibration cal = calibrate(model, ft_options(), log);
+  (void)kinds(cal);
+  std::vector<int> named;
+  for (const ModelPattern& p : cal.model_check.patterns) {
+    if (p.kind != "velocity_noise") continue;
+    named.push_back(p.joint);
+    const double slope = std::stod(p.message.substr(p.message.find("with slope ") + 11));
+    EXPECT_NEAR(slope, 1.0, 0.1) << p.message;
+    EXPECT_GE(p.share, 0.3) << p.message;
+    bool also_high_frequency = false;
+    for (const ModelPattern& h : cal.model_check.patterns)
+      also_high_frequency =
+          also_high_frequency || (h.kind == "high_frequency" && h.joint == p.joint &&
+                                  h.message.find("velocity's noise") != std::string::npos);
+    EXPECT_TRUE(also_high_frequency) << "joint " << p.joint;
+  }
+  ASSERT_GE(named.size(), 4u);
+  EXPECT_EQ(std::vector<int>(named.begin(), named.begin() + 4), (std::vector<int>{1, 2, 3, 4}));
+  // No other cause is made of it.
+  for (const ModelPattern& p : cal.model_check.patterns)
+    EXPECT_TRUE(p.kind == "velocity_noise" || p.kind == "high_frequency") << p.message;
 }
 
 // The same rotors, and one on joint 2 too, in a motion of two sines per joint (an identification

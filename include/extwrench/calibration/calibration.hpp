@@ -107,7 +107,7 @@ struct JointFitReport {
 /// A recognisable error of the model named by the model check (docs/calibration.md#model-check).
 struct ModelPattern {
   /// base_force_offset | gravity | coulomb | presliding | inertia | inertia_or_gravity |
-  /// sensor_pose | high_frequency
+  /// sensor_pose | high_frequency | velocity_noise
   std::string kind;
   int joint = 0;       ///< 1-based joint, 0 for the base sensor
   double share = 0.0;  ///< R² of the pattern's regression, or offset / spread
