@@ -159,6 +159,7 @@ py::dict calibrate_py(const Estimator& estimator, const std::filesystem::path& l
   d["tau_per_speed"] = c.tau_per_speed;
   d["residual_noise"] = c.residual_noise;
   d["residual_cutoff"] = c.residual_cutoff;
+  d["velocity_cutoff"] = c.velocity_cutoff;
   d["inertia_correction"] = c.inertia_correction;
   d["observer_gain"] = c.observer_gain;
   d["sensor_bias"] = c.sensor_type == SensorType::kNone ? py::object(py::none())

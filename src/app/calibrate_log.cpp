@@ -136,6 +136,12 @@ std::string calibration_report(const CalibrateLogResult& run, bool in_contact) {
       out << " " << cell(c.residual_cutoff[i], 0);
     out << " (RMS, noise and thresholds are of the filtered residual)\n";
   }
+  if ((c.velocity_cutoff.array() > 0.0).any()) {
+    out << "  velocity filter [Hz]:";
+    for (Eigen::Index i = 0; i < c.velocity_cutoff.size(); ++i)
+      out << " " << cell(c.velocity_cutoff[i], 0);
+    out << " (the fit saw the filtered dq, as the estimator does)\n";
+  }
   if (c.inertia_correction.size() > 0 && !c.inertia_correction.isZero(0.0)) {
     out << "  inertia correction [kg m^2] (p = B(q) dq + dI dq):";
     for (Eigen::Index i = 0; i < c.inertia_correction.size(); ++i)

@@ -8,8 +8,10 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
+#include "extwrench/observer/residual_filter.hpp"
 #include "friction_fit.hpp"
 #include "model_check.hpp"
 #include "payload_fit.hpp"
@@ -78,9 +80,11 @@ void remove_known_torque(const std::vector<Sample>& samples, int joint, JointSer
 }
 
 // The observer over the log with `friction`: residual r_k per joint (N × n), and e^{−K Δt_k}.
+// `momentum_dq`: the q̇ of the momentum per sample (the estimator's velocity filter), friction
+// taking the log's; empty: the log's for both.
 void run_observer(const Model& model, const VectorX& gains, const JointFriction& friction,
-                  const std::vector<Sample>& samples, std::vector<JointSeries>& series,
-                  bool residual_only) {
+                  const std::vector<Sample>& samples, const std::vector<VectorX>& momentum_dq,
+                  std::vector<JointSeries>& series, bool residual_only) {
   const int n = model.nq();
   Data data(model);
   MomentumObserver observer(model, gains);
@@ -100,8 +104,13 @@ void run_observer(const Model& model, const VectorX& gains, const JointFriction&
     throw Error("calibration: observer reset failed at the first sample");
   for (std::size_t k = 0; k < N; ++k) {
     const Sample& s = samples[k];
-    if (k > 0 && !observer.update(model, data, s.t, s.q, s.dq, s.tau).ok())
+    if (k > 0 && !observer.validate(s.t, s.q, s.dq, s.tau).ok())
       throw Error("calibration: sample " + std::to_string(k) + " rejected by the observer");
+    if (k > 0) {
+      const VectorX& dq = momentum_dq.empty() ? s.dq : momentum_dq[k];
+      momentum_terms(model, data, s.q, dq);  // as MomentumObserver::update
+      observer.integrate(data, s.t, s.q, dq, s.tau, s.dq);
+    }
     for (int i = 0; i < n; ++i) {
       JointSeries& js = series[static_cast<std::size_t>(i)];
       js.r0[k] = observer.residual()[i];
@@ -347,11 +356,12 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
 // (B(q_k) q̇_k)_i along the log: the model check compares the residual's fast part with what the
 // observer's momentum passes of the measured velocity's.
 void momentum_series(const Model& model, const std::vector<Sample>& samples,
-                     std::vector<JointSeries>& series) {
+                     const std::vector<VectorX>& momentum_dq, std::vector<JointSeries>& series) {
   Data data(model);
   for (JointSeries& js : series) js.momentum.assign(samples.size(), 0.0);
   for (std::size_t k = 0; k < samples.size(); ++k) {
-    const VectorX p = crba(model, data, samples[k].q) * samples[k].dq;
+    const VectorX& dq = momentum_dq.empty() ? samples[k].dq : momentum_dq[k];
+    const VectorX p = crba(model, data, samples[k].q) * dq;
     for (std::size_t i = 0; i < series.size(); ++i)
       series[i].momentum[k] = p[static_cast<Eigen::Index>(i)];
   }
@@ -513,16 +523,13 @@ std::optional<ThresholdModel> threshold_model(std::string_view name) {
   return std::nullopt;
 }
 
-Calibration calibrate(const Model& model, const EstimatorOptions& options,
-                      const std::vector<Sample>& samples, const CalibrationOptions& o) {
+namespace {
+
+// calibrate() on validated options and samples, the momentum's q̇ given (empty: the log's).
+Calibration calibrate_with(const Model& model, const EstimatorOptions& options,
+                           const std::vector<Sample>& samples,
+                           const std::vector<VectorX>& momentum_dq, const CalibrationOptions& o) {
   const int n = model.nq();
-  validate(options, model);
-  if (o.known_external_torque && options.sensor.type != SensorType::kNone) {
-    throw Error(
-        "calibration: a known external torque is for configurations without a base sensor "
-        "(sensor.type: none): the sensor's bias would absorb the contact force");
-  }
-  check_samples(samples, n, o.known_external_torque);
   const VectorX gains = MomentumObserver::checked_gains(options.observer_gain, n);
   const double settle =
       o.settle_time >= 0 ? o.settle_time : kSettleTimeConstants / gains.minCoeff();
@@ -573,16 +580,16 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
     body.inertia = body.inertia + identified;
   }
   std::vector<JointSeries> series, before;
-  run_observer(m, gains, JointFriction::none(n), samples, series, false);
+  run_observer(m, gains, JointFriction::none(n), samples, momentum_dq, series, false);
   run_observer(m, gains, options.friction ? *options.friction : JointFriction::from_model(model),
-               samples, before, true);
+               samples, momentum_dq, before, true);
   if (o.known_external_torque) {
     for (std::size_t i = 0; i < series.size(); ++i)
       remove_known_torque(samples, static_cast<int>(i), series[i], before[i]);
   }
 
   gravity_series(m, samples, o.inertia_correction, series);
-  momentum_series(m, samples, series);
+  momentum_series(m, samples, momentum_dq, series);
   cal.observer_gain = gains;
   cal.residual_cutoff = per_joint(options.residual_cutoff, n);
   // The residual filter: every series from here on is the filtered residual (r is linear in θ,
@@ -654,8 +661,8 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   cal.samples_used = static_cast<int>(std::count(use.begin(), use.end(), 1));
   friction_and_thresholds(fits, series, before, samples, use, o, cal);
   warn_unexplained_torque(samples, use, cal);
-  calibration_detail::check_joints(series, before, fits, samples, cal.residual_cutoff, use,
-                                   cal.model_check);
+  calibration_detail::check_joints(series, before, fits, samples, cal.residual_cutoff,
+                                   per_joint(options.velocity_cutoff, n), use, cal.model_check);
   if (options.sensor.type != SensorType::kNone)
     sensor_calibration(model, options, samples, use, o, cal);
   // A base moment linear in the configuration is a sensor pose error only when the joints do
@@ -670,6 +677,8 @@ Calibration calibrate(const Model& model, const EstimatorOptions& options,
   }
   return cal;
 }
+
+}  // namespace
 
 bool add_identified_payload(const Calibration& calibration, EstimatorOptions& options) {
   if (!calibration.payload.identified) return true;
@@ -686,6 +695,34 @@ bool add_identified_payload(const Calibration& calibration, EstimatorOptions& op
   return true;
 }
 
+// The momentum's q̇ through the estimator's velocity filter (as ContactEstimator::update does),
+// then the calibration of the log.
+Calibration calibrate(const Model& model, const EstimatorOptions& options,
+                      const std::vector<Sample>& samples, const CalibrationOptions& o) {
+  const int n = model.nq();
+  validate(options, model);
+  if (o.known_external_torque && options.sensor.type != SensorType::kNone) {
+    throw Error(
+        "calibration: a known external torque is for configurations without a base sensor "
+        "(sensor.type: none): the sensor's bias would absorb the contact force");
+  }
+  check_samples(samples, n, o.known_external_torque);
+  ResidualFilter velocity(options.velocity_cutoff, n);
+  std::vector<VectorX> momentum_dq;
+  if (velocity.enabled()) {
+    momentum_dq.reserve(samples.size());
+    velocity.reset(samples.front().dq);
+    momentum_dq.push_back(samples.front().dq);
+    for (std::size_t k = 1; k < samples.size(); ++k) {
+      momentum_dq.push_back(samples[k].dq);
+      velocity.apply(samples[k].t - samples[k - 1].t, momentum_dq.back());
+    }
+  }
+  Calibration cal = calibrate_with(model, options, samples, momentum_dq, o);
+  cal.velocity_cutoff = velocity.enabled() ? velocity.cutoff() : VectorX::Zero(n);
+  return cal;
+}
+
 EstimatorOptions apply_calibration(EstimatorOptions options, const Calibration& calibration) {
   if (!add_identified_payload(calibration, options)) {
     throw Error("calibration: the identified payload is on body " +
@@ -695,6 +732,8 @@ EstimatorOptions apply_calibration(EstimatorOptions options, const Calibration& 
   options.friction = calibration.friction;
   if (calibration.residual_cutoff.size() > 0)  // the thresholds are for its output
     options.residual_cutoff = calibration.residual_cutoff;
+  if (calibration.velocity_cutoff.size() > 0)  // and for the q̇ it saw
+    options.velocity_cutoff = calibration.velocity_cutoff;
   if (calibration.inertia_correction.size() > 0)  // part of the residual the fit minimised
     options.inertia_correction = calibration.inertia_correction;
   options.detection.tau_min = calibration.tau_threshold;

@@ -115,11 +115,30 @@ std::string inertia_size_and_sign(double delta) {
          ")";
 }
 
+// What lowers the velocity's noise on a joint with these filters [Hz] (0: none).
+std::string velocity_noise_remedy(double residual_cutoff, double velocity_cutoff) {
+  if (residual_cutoff > 0.0 || velocity_cutoff > 0.0) {
+    std::string filters;
+    if (velocity_cutoff > 0.0) filters = "velocity filter's " + num(velocity_cutoff) + " Hz";
+    if (residual_cutoff > 0.0)
+      filters += (filters.empty() ? "" : ", ") + std::string("residual filter's ") +
+                 num(residual_cutoff) + " Hz";
+    const bool both = residual_cutoff > 0.0 && velocity_cutoff > 0.0;
+    return "a lower cutoff than this joint's " + filters + (both ? "" : ", the other filter,") +
+           " or a lower gain lowers it further, at the cost of delay";
+  }
+  return "observer.velocity_cutoff or observer.residual_cutoff " + num(kSuggestedCutoff) +
+         " (Hz) on this joint lowers it (the first keeps the timing of a contact that loads the "
+         "torque, the second also removes the torque's noise), and so does a lower gain, at the "
+         "cost of delay";
+}
+
 }  // namespace
 
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
                   const std::vector<JointFrictionFit>& after, const std::vector<Sample>& samples,
-                  const VectorX& residual_cutoff, const std::vector<char>& use, ModelCheck& check) {
+                  const VectorX& residual_cutoff, const VectorX& velocity_cutoff,
+                  const std::vector<char>& use, ModelCheck& check) {
   const std::size_t n = series.size();
   const std::vector<double> suggested = residual_filter_weights(samples, kSuggestedCutoff);
   check.joint_rms = VectorX::Zero(static_cast<Eigen::Index>(n));
@@ -195,11 +214,8 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
                num(kSuggestedCutoff) + " Hz the residual follows it with slope " +
                num(noise.slope) + ", R^2 " + num(noise.r2) +
                "): no friction, offset or model parameter removes it; " +
-               (cutoff > 0.0
-                    ? "a residual filter below this joint's " + num(cutoff) + " Hz"
-                    : "observer.residual_cutoff " + num(kSuggestedCutoff) + " (Hz) on this joint") +
-               " or a lower gain lowers it, at the cost of delay, and so does a cleaner velocity "
-               "signal (docs/calibration.md#model-check)"});
+               velocity_noise_remedy(cutoff, velocity_cutoff[static_cast<Eigen::Index>(i)]) +
+               "; a cleaner velocity signal removes it too (docs/estimator.md#velocity-filter)"});
     }
     // Follows g(q): the calibrated residual against the filtered gravity torque.
     filter_regressor(s.gravity, s.alpha, z, s.filter_weight);

@@ -11,10 +11,12 @@ namespace extwrench::calibration_detail {
 
 /// Joint patterns. before[i].r0: the residual with the model as configured; after[i]: the
 /// calibrated residual; series[i]: q̇, g_i(q_k) and the observer's filter; samples: the log
-/// (its time stamps); residual_cutoff: the configured residual filter per joint (n).
+/// (its time stamps); residual_cutoff, velocity_cutoff: the configured residual and velocity
+/// filters per joint (n).
 void check_joints(const std::vector<JointSeries>& series, const std::vector<JointSeries>& before,
                   const std::vector<JointFrictionFit>& after, const std::vector<Sample>& samples,
-                  const VectorX& residual_cutoff, const std::vector<char>& use, ModelCheck& check);
+                  const VectorX& residual_cutoff, const VectorX& velocity_cutoff,
+                  const std::vector<char>& use, ModelCheck& check);
 
 /// Base-sensor patterns from error_S = reading − predicted (no bias) and predicted_S, per used
 /// sample; `moments`: a 6-axis sensor.

@@ -30,9 +30,16 @@ double settle_time_of(const EstimatorOptions& options, const MomentumObserver& o
   const double slowest = options.acceleration == AccelerationRoute::kResidual
                              ? 1.0 / observer.gains().minCoeff()
                              : 1.0 / (2.0 * std::numbers::pi * options.differentiation_cutoff);
-  double filter = 0.0;  // the slowest filtered joint's two sections
-  for (const double cutoff : options.residual_cutoff)
-    if (cutoff > 0.0) filter = std::max(filter, 2.0 / (2.0 * std::numbers::pi * cutoff));
+  // The slowest filtered joint's two sections, of the residual and of the velocity (in series
+  // for a force that moves the arm).
+  const auto slowest_filter = [](const VectorX& cutoffs) {
+    double time = 0.0;
+    for (const double cutoff : cutoffs)
+      if (cutoff > 0.0) time = std::max(time, 2.0 / (2.0 * std::numbers::pi * cutoff));
+    return time;
+  };
+  const double filter =
+      slowest_filter(options.residual_cutoff) + slowest_filter(options.velocity_cutoff);
   return std::max(kSettleTimeConstants * (slowest + filter), options.detection.min_duration);
 }
 
@@ -47,6 +54,8 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
       geometry_(std::move(geometry)),
       observer_(model_, options_.observer_gain),
       residual_filter_(options_.residual_cutoff, model_.nq()),
+      velocity_filter_(options_.velocity_cutoff, model_.nq()),
+      dq_filtered_(VectorX::Zero(model_.nq())),
       detector_(options_.detection, model_.nq(), settle_time_of(options_, observer_)),
       isolation_ws_(model_),
       noise_(make_noise_model(options_.uncertainty, model_.nq(), options_.sensor.X_WS.rotation)),
@@ -110,7 +119,8 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   dq_prev_ = dq;
   have_dq_prev_ = true;
   ddq_filtered_.setZero();
-  residual_filter_.reset();  // r = 0 at a reset
+  residual_filter_.reset();    // r = 0 at a reset
+  velocity_filter_.reset(dq);  // at rest on the first q̇, which the observer started from
   detector_.reset();
   disagreement_on_ = false;
   have_disagreement_edge_ = false;
@@ -208,11 +218,19 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
   }
   const double dt = t - t_;
   ddq_supplied_ = false;
-  momentum_and_bias_terms_stage(q, dq);           // 1
-  observer_.integrate(data_, t, q, dq, tau);      // 2 (validated above)
-  out_.status = acceleration_route(dt, dq, tau);  // 3
-  ground_wrench(dq);                              // 4
-  residual_filter_.apply(dt, tau_ext_);           // τ̂_ext low-passed (no-op by default)
+  // The momentum and its bias terms take q̇ through the velocity filter (validated above: its
+  // state stays finite); friction, q̈̂'s differentiation and the thresholds the measured q̇.
+  if (velocity_filter_.enabled()) {
+    dq_filtered_ = dq;
+    velocity_filter_.apply(dt, dq_filtered_);
+  }
+  const Eigen::Ref<const VectorX> dq_momentum =
+      velocity_filter_.enabled() ? Eigen::Ref<const VectorX>(dq_filtered_) : dq;
+  momentum_and_bias_terms_stage(q, dq_momentum);           // 1
+  observer_.integrate(data_, t, q, dq_momentum, tau, dq);  // 2 (validated above)
+  out_.status = acceleration_route(dt, dq, tau);           // 3
+  ground_wrench(dq_momentum);                              // 4
+  residual_filter_.apply(dt, tau_ext_);                    // τ̂_ext low-passed (no-op by default)
   dq_prev_ = dq;
   t_ = t;
   estimate(t, dq, reading_S);  // 5–9

@@ -35,6 +35,9 @@ void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   if (!(o.residual_cutoff.array() >= 0.0).all() || !o.residual_cutoff.allFinite()) {
     throw Error(where + ": observer.residual_cutoff: expected finite values >= 0 [Hz] (0: none)");
   }
+  if (!(o.velocity_cutoff.array() >= 0.0).all() || !o.velocity_cutoff.allFinite()) {
+    throw Error(where + ": observer.velocity_cutoff: expected finite values >= 0 [Hz] (0: none)");
+  }
   if (!(o.solver.max_condition > 1.0) || !std::isfinite(o.solver.max_condition)) {
     throw Error(where + ": solver.max_condition: expected a finite value > 1");
   }
@@ -114,6 +117,10 @@ void validate(const EstimatorOptions& o, const Model& model) {
   if (o.residual_cutoff.size() != 1 && o.residual_cutoff.size() != n) {
     throw Error(where + ": observer.residual_cutoff: expected 1 or " + std::to_string(n) +
                 " values, got " + std::to_string(o.residual_cutoff.size()));
+  }
+  if (o.velocity_cutoff.size() != 1 && o.velocity_cutoff.size() != n) {
+    throw Error(where + ": observer.velocity_cutoff: expected 1 or " + std::to_string(n) +
+                " values, got " + std::to_string(o.velocity_cutoff.size()));
   }
   (void)MomentumObserver::checked_inertia_correction(o.inertia_correction, n);
   if (o.friction) validate_friction(*o.friction, n, "MomentumObserver");

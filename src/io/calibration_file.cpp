@@ -163,6 +163,8 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
   y << "observer: {gain: " << yaml_list(c.observer_gain);
   if ((c.residual_cutoff.array() > 0.0).any())
     y << ", residual_cutoff: " << yaml_list(c.residual_cutoff);
+  if ((c.velocity_cutoff.array() > 0.0).any())
+    y << ", velocity_cutoff: " << yaml_list(c.velocity_cutoff);
   if (c.inertia_correction.size() > 0 && !c.inertia_correction.isZero(0.0))
     y << ", inertia_correction: " << yaml_list(c.inertia_correction);
   y << "}\n";
@@ -233,12 +235,17 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
     const io_detail::Range positive = io_detail::positive();
     const io_detail::Range non_negative = io_detail::non_negative(">= 0 [N]");
     const YAML::Node ob = rd.required(root, "", "observer");
-    rd.only_keys(ob, "observer", {"gain", "residual_cutoff", "inertia_correction"});
+    rd.only_keys(ob, "observer",
+                 {"gain", "residual_cutoff", "velocity_cutoff", "inertia_correction"});
     c.observer_gain = rd.vector(rd.required(ob, "observer", "gain"), "observer.gain", n, &positive);
     // Absent in files written before the residual filter: none.
     const io_detail::Range cutoff = io_detail::non_negative(">= 0 [Hz] (0: none)");
     c.residual_cutoff = ob["residual_cutoff"] ? rd.vector(ob["residual_cutoff"],
                                                           "observer.residual_cutoff", n, &cutoff)
+                                              : VectorX::Zero(n);
+    // Absent in files written before the velocity filter, and without one: none.
+    c.velocity_cutoff = ob["velocity_cutoff"] ? rd.vector(ob["velocity_cutoff"],
+                                                          "observer.velocity_cutoff", n, &cutoff)
                                               : VectorX::Zero(n);
     // Absent where none was fitted (and in files written before it): zero.
     c.inertia_correction = ob["inertia_correction"] ? rd.vector(ob["inertia_correction"],

@@ -57,12 +57,15 @@ void read_contact(const YamlReader& rd, const YAML::Node& c, const Model& model,
 }
 
 void read_observer(const YamlReader& rd, const YAML::Node& ob, int n, EstimatorOptions& o) {
-  rd.only_keys(ob, "observer", {"gain", "residual_cutoff", "inertia_correction"});
+  rd.only_keys(ob, "observer",
+               {"gain", "residual_cutoff", "velocity_cutoff", "inertia_correction"});
   const Range gain = positive();
   if (ob["gain"]) o.observer_gain = rd.vector(ob["gain"], "observer.gain", n, &gain);
   const Range cutoff = io_detail::non_negative(">= 0 [Hz] (0: none)");
   if (ob["residual_cutoff"])
     o.residual_cutoff = rd.vector(ob["residual_cutoff"], "observer.residual_cutoff", n, &cutoff);
+  if (ob["velocity_cutoff"])
+    o.velocity_cutoff = rd.vector(ob["velocity_cutoff"], "observer.velocity_cutoff", n, &cutoff);
   if (ob["inertia_correction"])
     o.inertia_correction = rd.vector(ob["inertia_correction"], "observer.inertia_correction", n);
 }
@@ -157,17 +160,23 @@ fs::path read_calibration(const YamlReader& rd, const YAML::Node& root, const fs
   }
   // The thresholds hold for the residual filtered as it was at calibration: taken from the file
   // unless set here, and then it must be the same.
+  // The same for the velocity filter: the fit saw the filtered q̇.
   const YAML::Node ob = root["observer"];
-  const VectorX cutoff = per_joint(o.residual_cutoff, n);
-  if (!(ob && ob["residual_cutoff"])) {
-    o.residual_cutoff = cal.residual_cutoff;
-  } else if (cutoff != cal.residual_cutoff) {
-    rd.fail(node, "calibration",
-            "'" + path.string() + "' was made with observer.residual_cutoff " +
-                io_detail::yaml_list(cal.residual_cutoff) + ", this configuration uses " +
-                io_detail::yaml_list(cutoff) +
-                ": its thresholds are for that filter; set the same cutoff or calibrate again");
-  }
+  const auto same_filter = [&](const char* key, VectorX& configured, const VectorX& calibrated) {
+    const VectorX cutoff = per_joint(configured, n);
+    if (!(ob && ob[key])) {
+      configured = calibrated;
+    } else if (cutoff != calibrated) {
+      rd.fail(node, "calibration",
+              "'" + path.string() + "' was made with observer." + key + " " +
+                  io_detail::yaml_list(calibrated) + ", this configuration uses " +
+                  io_detail::yaml_list(cutoff) +
+                  ": its thresholds are for that filter; set the same cutoff or calibrate again");
+    }
+  };
+  same_filter("residual_cutoff", o.residual_cutoff, cal.residual_cutoff);
+  same_filter("velocity_cutoff", o.velocity_cutoff,
+              cal.velocity_cutoff.size() > 0 ? cal.velocity_cutoff : VectorX::Zero(n));
   if (cal.sensor_type != o.sensor.type) {
     rd.fail(node, "calibration",
             "'" + path.string() + "' was made for sensor type " +
@@ -439,6 +448,8 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   y << "observer:\n  gain: " << io_detail::yaml_list(o.observer_gain) << '\n';
   if ((o.residual_cutoff.array() > 0.0).any())
     y << "  residual_cutoff: " << io_detail::yaml_list(o.residual_cutoff) << '\n';
+  if ((o.velocity_cutoff.array() > 0.0).any())
+    y << "  velocity_cutoff: " << io_detail::yaml_list(o.velocity_cutoff) << '\n';
   if (!o.inertia_correction.isZero(0.0))
     y << "  inertia_correction: " << io_detail::yaml_list(o.inertia_correction) << '\n';
   y << "detection:\n  tau_min: " << io_detail::yaml_list(o.detection.tau_min);

@@ -40,6 +40,7 @@ MomentumObserver::MomentumObserver(const Model& model, const VectorX& gains) : n
   tau_prev_ = VectorX::Zero(n_);
   q_prev_ = VectorX::Zero(n_);
   dq_prev_ = VectorX::Zero(n_);
+  friction_dq_prev_ = VectorX::Zero(n_);
   alpha_ = VectorX::Zero(n_);
   tau_f_ = VectorX::Zero(n_);
   gamma_ = VectorX::Zero(n_);
@@ -57,7 +58,7 @@ void MomentumObserver::set_friction(const JointFriction& friction) {
   if (initialized_) {
     // γ_k = Cᵀq̇ − g − τ_f at sample k: swap the old τ_f(q̇_k) for the new one.
     gamma_ = tau_f_;
-    extwrench::friction_torque(friction_, dq_prev_, presliding_state_, tau_f_);
+    extwrench::friction_torque(friction_, friction_dq_prev_, presliding_state_, tau_f_);
     gamma_prev_ += gamma_ - tau_f_;
   }
 }
@@ -108,7 +109,7 @@ void MomentumObserver::reanchor(const Model& model, Data& data) noexcept {
   // contains no jump and r stays continuous.
   if (!initialized_) return;
   momentum_terms(model, data, q_prev_, dq_prev_);
-  integrand(data, dq_prev_);
+  integrand(data, friction_dq_prev_);
   anchor_momentum(data, dq_prev_);
   gamma_prev_ = gamma_;
 }
@@ -129,6 +130,7 @@ Status MomentumObserver::reset(const Model& model, Data& data, double t,
   gamma_prev_ = gamma_;
   q_prev_ = q;
   dq_prev_ = dq;
+  friction_dq_prev_ = dq;
   have_tau_ = false;
   initialized_ = true;
   return Status::success();
@@ -171,13 +173,20 @@ Status MomentumObserver::update(const Model& model, Data& data, double t,
 void MomentumObserver::integrate(const Data& data, double t, const Eigen::Ref<const VectorX>& q,
                                  const Eigen::Ref<const VectorX>& dq,
                                  const Eigen::Ref<const VectorX>& tau) noexcept {
+  integrate(data, t, q, dq, tau, dq);
+}
+
+void MomentumObserver::integrate(const Data& data, double t, const Eigen::Ref<const VectorX>& q,
+                                 const Eigen::Ref<const VectorX>& dq,
+                                 const Eigen::Ref<const VectorX>& tau,
+                                 const Eigen::Ref<const VectorX>& friction_dq) noexcept {
   const double dt = t - t_;
   if (friction_.sign == SmoothSign::kDahl) {
     for (int i = 0; i < n_; ++i)
       presliding_state_[i] =
           dahl_step(presliding_state_[i], q[i] - q_prev_[i], friction_.presliding[i]);
   }
-  integrand(data, dq);
+  integrand(data, friction_dq);
   if (dt != alpha_dt_) {
     alpha_ = (-gains_ * dt).array().exp();  // e^{−K Δt}, recomputed only when Δt changes
     alpha_dt_ = dt;
@@ -199,6 +208,7 @@ void MomentumObserver::integrate(const Data& data, double t, const Eigen::Ref<co
   have_tau_ = true;
   q_prev_ = q;
   dq_prev_ = dq;
+  friction_dq_prev_ = friction_dq;
   t_ = t;
 }
 

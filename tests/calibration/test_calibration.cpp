@@ -16,6 +16,7 @@
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/log.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/random.hpp"
 
 namespace extwrench {
 namespace {
@@ -469,6 +470,50 @@ void expect_estimator_residual_is_the_fits(const Model& model, const EstimatorOp
   }
 }
 
+// The configuration head of the paper arm without a sensor.
+std::string paper_arm_head() {
+  const std::string robot = (fs::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf").string();
+  return "robot: " + robot + "\nsensor: {type: none}\n";
+}
+
+// A calibration made with a filter (observer.KEY = `cutoff`, as YAML), written to DIR/calib.yaml:
+// a configuration that includes it takes the cutoff; another one there (`other`) is refused with
+// the line and the calibration's value; a negative one is named; written back, it is kept.
+void expect_cutoff_carried(const Calibration& cal, const std::string& key, const VectorX& cutoff,
+                           const std::string& cutoff_text, const std::string& other,
+                           const fs::path& dir) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "calib.yaml") << calibration_to_yaml(cal, nullptr);
+  const std::string head = paper_arm_head();
+  const auto value = [&](const EstimatorConfig& c) {
+    return key == "residual_cutoff" ? c.options.residual_cutoff : c.options.velocity_cutoff;
+  };
+  const EstimatorConfig cfg = load_estimator_config_string(
+      head + "observer: {gain: 50}\ncalibration: calib.yaml\n", dir / "config.yaml");
+  EXPECT_EQ(value(cfg), cutoff);
+  try {
+    (void)load_estimator_config_string(
+        head + "observer: {gain: 50, " + key + ": " + other + "}\ncalibration: calib.yaml\n",
+        dir / "config.yaml");
+    ADD_FAILURE() << "another " << key << " than the calibration's was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("config.yaml:4: calibration"), std::string::npos) << what;
+    EXPECT_NE(what.find(key + " " + cutoff_text), std::string::npos) << what;
+  }
+  try {
+    (void)load_estimator_config_string(head + "observer: {gain: 50, " + key + ": -1}\n",
+                                       dir / "config.yaml");
+    ADD_FAILURE() << "a negative " << key << " was accepted";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("config.yaml:3"), std::string::npos) << what;
+    EXPECT_NE(what.find("observer." + key), std::string::npos) << what;
+  }
+  const EstimatorConfig again = load_estimator_config_string(to_yaml(cfg, dir), dir / "w.yaml");
+  EXPECT_EQ(value(again), cutoff);
+}
+
 // The residual filter (observer.residual_cutoff) through calibration: the thresholds and noise
 // are those of the filtered residual, exactly the one the estimator's detector sees; CALIB.yaml
 // carries the cutoff to the configuration that includes it; another cutoff there is refused; a
@@ -495,38 +540,17 @@ TEST(CalibrationFile, TheResidualFilterIsCalibratedAndCarriedWithItsThresholds) 
   }
   cal.source = "free.csv";
   const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_filter";
-  fs::create_directories(dir);
-  std::ofstream(dir / "calib.yaml") << calibration_to_yaml(cal, nullptr);
-  const std::string robot = (fs::path(EXTWRENCH_SOURCE_DIR) / "models/paper_arm.urdf").string();
-  const std::string head = "robot: " + robot + "\nsensor: {type: none}\n";
+  expect_cutoff_carried(cal, "residual_cutoff", options.residual_cutoff,
+                        "[15, 15, 15, 15, 0, 0, 0]", "30", dir);
+  const std::string head = paper_arm_head();
   const EstimatorConfig cfg = load_estimator_config_string(
       head + "observer: {gain: 50}\ncalibration: calib.yaml\n", dir / "config.yaml");
-  EXPECT_EQ(cfg.options.residual_cutoff, options.residual_cutoff);
   const EstimatorConfig same = load_estimator_config_string(
       head +
           "observer: {gain: 50, residual_cutoff: [15, 15, 15, 15, 0, 0, 0]}\ncalibration: "
           "calib.yaml\n",
       dir / "config.yaml");
   EXPECT_EQ(same.options.residual_cutoff, options.residual_cutoff);
-  try {
-    (void)load_estimator_config_string(
-        head + "observer: {gain: 50, residual_cutoff: 30}\ncalibration: calib.yaml\n",
-        dir / "config.yaml");
-    FAIL() << "another cutoff than the calibration's was accepted";
-  } catch (const Error& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("config.yaml:4: calibration"), std::string::npos) << what;
-    EXPECT_NE(what.find("residual_cutoff [15, 15, 15, 15, 0, 0, 0]"), std::string::npos) << what;
-  }
-  try {
-    (void)load_estimator_config_string(head + "observer: {gain: 50, residual_cutoff: -1}\n",
-                                       dir / "config.yaml");
-    FAIL() << "a negative cutoff was accepted";
-  } catch (const Error& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("config.yaml:3"), std::string::npos) << what;
-    EXPECT_NE(what.find("observer.residual_cutoff"), std::string::npos) << what;
-  }
   // Without the key, as before the filter existed: none.
   const EstimatorConfig none =
       load_estimator_config_string(head + "observer: {gain: 50}\n", dir / "config.yaml");
@@ -534,6 +558,34 @@ TEST(CalibrationFile, TheResidualFilterIsCalibratedAndCarriedWithItsThresholds) 
   // Written back, the configuration keeps the cutoff.
   const EstimatorConfig again = load_estimator_config_string(to_yaml(cfg, dir), dir / "w.yaml");
   EXPECT_EQ(again.options.residual_cutoff, options.residual_cutoff);
+}
+
+// The velocity filter (observer.velocity_cutoff) through calibration: the fit sees the log's q̇
+// through it, as the estimator does, so the estimator's residual is the fit's; CALIB.yaml carries
+// the cutoff to the configuration that includes it; another cutoff there is refused; a negative
+// one is named; written back, the configuration keeps it.
+TEST(CalibrationFile, TheVelocityFilterIsCalibratedAndCarriedWithItsThresholds) {
+  const Model model = paper_arm();
+  EstimatorOptions options = no_sensor();
+  options.velocity_cutoff = VectorX{{25, 25, 25, 25, 0, 0, 0}};
+  auto log = test::simulate_free_motion(model, test::free_motion(0.0, 1.0),
+                                        test::paper_arm_friction(), 8.0, Vector6::Zero(), 0.02, 7);
+  test::SeededRng rng(7);
+  for (Sample& s : log) s.dq += rng.uniform_vector(7, -0.004, 0.004);  // a noisy velocity
+  const Calibration plain = calibrate(model, no_sensor(), log);
+  Calibration cal = calibrate(model, options, log);
+  for (const std::string& w : cal.warnings) std::printf("warning: %s\n", w.c_str());
+  EXPECT_EQ(cal.velocity_cutoff, options.velocity_cutoff);
+  EXPECT_EQ(plain.velocity_cutoff, VectorX::Zero(7));
+  expect_estimator_residual_is_the_fits(model, apply_calibration(options, cal), log, cal);
+  for (int i = 0; i < 4; ++i) {
+    const auto j = static_cast<std::size_t>(i);
+    EXPECT_LT(cal.joints[j].noise_std, 0.8 * plain.joints[j].noise_std) << "joint " << i + 1;
+  }
+  cal.source = "free.csv";
+  expect_cutoff_carried(cal, "velocity_cutoff", options.velocity_cutoff,
+                        "[25, 25, 25, 25, 0, 0, 0]", "10",
+                        fs::temp_directory_path() / "extwrench_calibration_velocity_filter");
 }
 
 // The inertia correction (observer.inertia_correction) through calibration: on an arm with a

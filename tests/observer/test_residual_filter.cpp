@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "extwrench/estimation/contact_estimator.hpp"
@@ -110,6 +111,48 @@ TEST(ResidualFilter, TheEstimatorsResidualIsTheObserversThroughTheFilter) {
     reference.apply(dt, expected);
     ASSERT_EQ(a.result().residual, expected) << "sample " << k;
   }
+}
+
+// observer.velocity_cutoff: the estimator's momentum takes q̇ through the same filter, started at
+// rest on the first q̇ — without friction (which takes the measured q̇), bit for bit an estimator
+// without the filter fed the filtered q̇.
+TEST(VelocityFilter, TheMomentumTakesTheFilteredVelocity) {
+  const Model model = test::paper_arm_model();
+  EstimatorOptions plain;
+  plain.observer_gain = VectorX::Constant(1, 50.0);
+  plain.friction = JointFriction::none(7);
+  EstimatorOptions filtered = plain;
+  filtered.velocity_cutoff = VectorX{{kCutoff, kCutoff, kCutoff, kCutoff, 0.0, 0.0, 0.0}};
+  ContactEstimator a(model, {}, filtered), b(model, {}, plain);
+  test::SeededRng rng(13);
+  VectorX q = rng.uniform_vector(7, -1, 1);
+  VectorX dq = rng.uniform_vector(7, -0.5, 0.5);
+  const VectorX tau = rng.uniform_vector(7, -5, 5);
+  ASSERT_TRUE(a.reset(0.0, q, dq, tau).ok());
+  ASSERT_TRUE(b.reset(0.0, q, dq, tau).ok());
+  ResidualFilter reference(filtered.velocity_cutoff, 7);
+  reference.reset(dq);
+  double t = 0.0;
+  for (int k = 0; k < 500; ++k) {
+    const double t_prev = t;
+    t += k % 2 ? 1e-3 : 1.2e-3;
+    q += (t - t_prev) * dq;
+    dq += rng.uniform_vector(7, -0.05, 0.05);  // a noisy velocity
+    VectorX dq_filtered = dq;
+    reference.apply(t - t_prev, dq_filtered);
+    ASSERT_TRUE(a.update(t, q, dq, tau).ok());
+    ASSERT_TRUE(b.update(t, q, dq_filtered, tau).ok());
+    ASSERT_EQ(a.result().residual, b.result().residual) << "sample " << k;
+  }
+  // A bad sample is refused before the filter: the state goes on as if it had not come.
+  VectorX bad = dq;
+  bad[1] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(a.update(t + 1e-3, q, bad, tau).ok());
+  VectorX dq_filtered = dq;
+  reference.apply((t + 2e-3) - t, dq_filtered);  // the step as the estimator takes it
+  ASSERT_TRUE(a.update(t + 2e-3, q, dq, tau).ok());
+  ASSERT_TRUE(b.update(t + 2e-3, q, dq_filtered, tau).ok());
+  EXPECT_EQ(a.result().residual, b.result().residual);
 }
 
 }  // namespace

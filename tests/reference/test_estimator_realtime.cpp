@@ -56,6 +56,7 @@ struct Config {
   double residual_cutoff = 0.0;     ///< [Hz] the residual filter (0: none)
   double inertia_correction = 0.0;  ///< [kg m^2] δI on every joint (0: none)
   double inertial_margin = 0.0;     ///< detection.inertial_margin on every joint (0: none)
+  double velocity_cutoff = 0.0;     ///< [Hz] the velocity filter (0: none)
 };
 
 std::vector<Config> all_configs() {
@@ -69,8 +70,10 @@ std::vector<Config> all_configs() {
     }
     // The residual filter's state too (observer.residual_cutoff), with a calibration's inertia
     // correction (observer.inertia_correction: the momentum and, route (b), B + δI) and
-    // thresholds that follow the dynamic torque (detection.inertial_margin).
-    out.push_back({s, ContactModel::kPureForce, AccelerationRoute::kResidual, 80.0, 0.05, 0.02});
+    // thresholds that follow the dynamic torque (detection.inertial_margin), and the velocity
+    // filter's (observer.velocity_cutoff).
+    out.push_back(
+        {s, ContactModel::kPureForce, AccelerationRoute::kResidual, 80.0, 0.05, 0.02, 60.0});
   }
   return out;
 }
@@ -88,6 +91,7 @@ EstimatorOptions options_for(const Config& c) {
   o.sensor.tare_samples = 5;
   o.residual_cutoff = VectorX::Constant(1, c.residual_cutoff);
   o.inertia_correction = VectorX::Constant(1, c.inertia_correction);
+  o.velocity_cutoff = VectorX::Constant(1, c.velocity_cutoff);
   if (c.inertial_margin > 0) o.detection.inertial_margin = VectorX::Constant(1, c.inertial_margin);
   return o;
 }
@@ -98,7 +102,8 @@ std::string describe(const Config& c) {
          (c.residual_cutoff > 0 ? "/residual_cutoff " + std::to_string(c.residual_cutoff) : "") +
          (c.inertia_correction != 0 ? "/inertia_correction " + std::to_string(c.inertia_correction)
                                     : "") +
-         (c.inertial_margin > 0 ? "/inertial_margin " + std::to_string(c.inertial_margin) : "");
+         (c.inertial_margin > 0 ? "/inertial_margin " + std::to_string(c.inertial_margin) : "") +
+         (c.velocity_cutoff > 0 ? "/velocity_cutoff " + std::to_string(c.velocity_cutoff) : "");
 }
 
 TEST(EstimatorRealTime, TenThousandUpdatesOfEveryConfigurationAllocateNothing) {

@@ -154,6 +154,8 @@ class ContactEstimator {
   MomentumObserver observer_;
   bool inertia_corrected_ = false;  ///< options_.inertia_correction is not zero
   ResidualFilter residual_filter_;  ///< options_.residual_cutoff on τ̂_ext (off at 0)
+  ResidualFilter velocity_filter_;  ///< options_.velocity_cutoff on q̇ (off at 0)
+  VectorX dq_filtered_;             ///< q̇ through velocity_filter_ (n)
   ContactDetector detector_;
   IsolationRule isolation_rule_ = IsolationRule::kResidual;  ///< options_.isolation resolved
   IsolationWorkspace isolation_ws_;

@@ -95,6 +95,12 @@ class MomentumObserver {
   void integrate(const Data& data, double t, const Eigen::Ref<const VectorX>& q,
                  const Eigen::Ref<const VectorX>& dq,
                  const Eigen::Ref<const VectorX>& tau) noexcept;
+  /// As integrate, with the joint friction τ_f evaluated at `friction_dq` rather than at the q̇
+  /// of the momentum (the estimator's velocity filter: the momentum takes the filtered q̇, the
+  /// friction the measured one, whose sign a filter would delay at every reversal).
+  void integrate(const Data& data, double t, const Eigen::Ref<const VectorX>& q,
+                 const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau,
+                 const Eigen::Ref<const VectorX>& friction_dq) noexcept;
 
   /// After an edit of the model's mass properties (a payload): recomputes the momentum of the
   /// last (q, q̇) with `model` (momentum_terms on `data`), so that the next Δy contains no jump
@@ -136,6 +142,7 @@ class MomentumObserver {
   VectorX gamma_prev_;        ///< γ_k = Cᵀq̇ − g − τ_f at sample k
   VectorX tau_prev_;          ///< τ_k (held over [t_k, t_{k+1}))
   VectorX q_prev_, dq_prev_;
+  VectorX friction_dq_prev_;  ///< the q̇ friction was evaluated at, sample k
 
   // Cached e^{−K Δt} for the last Δt (uniform sampling computes the exponentials once).
   double alpha_dt_ = -1.0;
