@@ -140,7 +140,7 @@ std::string calibration_report(const CalibrateLogResult& run, bool in_contact) {
     out << "  velocity filter [Hz]:";
     for (Eigen::Index i = 0; i < c.velocity_cutoff.size(); ++i)
       out << " " << cell(c.velocity_cutoff[i], 0);
-    out << " (the fit saw the filtered dq, as the estimator does)\n";
+    out << " (the observer's momentum takes the filtered dq, as the estimator's)\n";
   }
   if (c.inertia_correction.size() > 0 && !c.inertia_correction.isZero(0.0)) {
     out << "  inertia correction [kg m^2] (p = B(q) dq + dI dq):";

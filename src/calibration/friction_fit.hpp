@@ -27,7 +27,8 @@ inline constexpr double kResolvableTorque = 1e-3;
 /// first axis), so no mass distribution gives it a gravity torque.
 struct JointSeries {
   std::vector<double> q, dq, r0, alpha, dt, filter_weight, gravity;
-  /// (B(q_k) q̇_k)_i: the momentum the observer forms from the measured velocity (model check).
+  /// (B(q_k) q̇_k)_i: the momentum the observer forms, of the measured q̇ or of the velocity
+  /// filter's (model check).
   std::vector<double> momentum;
   std::array<std::vector<double>, 4> payload_gravity;
   bool axis_along_gravity = false;

@@ -137,9 +137,9 @@ struct Calibration {
   /// The residual filter's cutoff per joint they were computed with (n) [Hz] (0: none;
   /// residual_filter.hpp).
   VectorX residual_cutoff;
-  /// The velocity filter's cutoff per joint (n) [Hz] (0: none): the log's q̇ went through it
-  /// before the fit, as the estimator's does. Empty when loaded from a file written before it
-  /// existed (none).
+  /// The velocity filter's cutoff per joint (n) [Hz] (0: none): the fit's observer formed its
+  /// momentum from the log's q̇ through it, as the estimator's does. Empty when loaded from a
+  /// file written before it existed (none).
   VectorX velocity_cutoff;
   /// δI per joint (n) [kg m² | kg]: the observer's momentum correction fitted with the friction
   /// (0 where not kept; EstimatorOptions::inertia_correction). Empty when loaded from a file

@@ -58,9 +58,10 @@ struct EstimatorOptions {
   /// (residual_filter.hpp); 0: none. For real arms whose q̇ noise reaches r through K B(q) δq̇
   /// (docs/estimator.md#residual-filter).
   VectorX residual_cutoff = VectorX::Zero(1);
-  /// [Hz] ≥ 0, size 1 or n: the same second-order low-pass on the measured q̇ before every stage
-  /// (the momentum, friction, q̈̂, thresholds); 0: none. It removes the velocity's noise that the
-  /// observer passes as K B(q) δq̇ while a torque-borne τ_ext keeps the observer's own bandwidth
+  /// [Hz] ≥ 0, size 1 or n: the same second-order low-pass on the q̇ of the momentum pass
+  /// (p = B(q) q̇, Cᵀq̇, the bias terms); friction, q̈'s differentiation and the thresholds keep
+  /// the measured q̇; 0: none. It removes the velocity's noise that the observer passes as
+  /// K B(q) δq̇ while a torque-borne τ_ext keeps the observer's own bandwidth
   /// (docs/estimator.md#velocity-filter). Not applied by update_with (q̇ as given).
   VectorX velocity_cutoff = VectorX::Zero(1);
   /// δI [kg m² | kg], size 1 or n, finite, any sign: added to the momentum the observer
