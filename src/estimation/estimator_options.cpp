@@ -28,16 +28,24 @@ void validate_sensor(const SensorOptions& s, const std::string& where) {
   if (!s.bias_S.allFinite()) throw Error(where + ": sensor.bias: expected finite values");
 }
 
+// observer.KEY (a residual or velocity filter's cutoffs [Hz]): finite values >= 0; with the
+// model's n, also 1 or n of them.
+void validate_cutoffs(const VectorX& cutoff, const char* key, const std::string& where, int n = 0) {
+  if (!(cutoff.array() >= 0.0).all() || !cutoff.allFinite()) {
+    throw Error(where + ": observer." + key + ": expected finite values >= 0 [Hz] (0: none)");
+  }
+  if (n > 0 && cutoff.size() != 1 && cutoff.size() != n) {
+    throw Error(where + ": observer." + key + ": expected 1 or " + std::to_string(n) +
+                " values, got " + std::to_string(cutoff.size()));
+  }
+}
+
 void validate_numerics(const EstimatorOptions& o, const std::string& where) {
   if (!(o.differentiation_cutoff > 0.0) || !std::isfinite(o.differentiation_cutoff)) {
     throw Error(where + ": acceleration cutoff: expected a finite value > 0 [Hz]");
   }
-  if (!(o.residual_cutoff.array() >= 0.0).all() || !o.residual_cutoff.allFinite()) {
-    throw Error(where + ": observer.residual_cutoff: expected finite values >= 0 [Hz] (0: none)");
-  }
-  if (!(o.velocity_cutoff.array() >= 0.0).all() || !o.velocity_cutoff.allFinite()) {
-    throw Error(where + ": observer.velocity_cutoff: expected finite values >= 0 [Hz] (0: none)");
-  }
+  validate_cutoffs(o.residual_cutoff, "residual_cutoff", where);
+  validate_cutoffs(o.velocity_cutoff, "velocity_cutoff", where);
   if (!(o.solver.max_condition > 1.0) || !std::isfinite(o.solver.max_condition)) {
     throw Error(where + ": solver.max_condition: expected a finite value > 1");
   }
@@ -114,14 +122,8 @@ void validate(const EstimatorOptions& o, const Model& model) {
   validate_friction(JointFriction::from_model(model), n,
                     "MomentumObserver: model '" + model.name + "'");
   validate(o.detection, n);
-  if (o.residual_cutoff.size() != 1 && o.residual_cutoff.size() != n) {
-    throw Error(where + ": observer.residual_cutoff: expected 1 or " + std::to_string(n) +
-                " values, got " + std::to_string(o.residual_cutoff.size()));
-  }
-  if (o.velocity_cutoff.size() != 1 && o.velocity_cutoff.size() != n) {
-    throw Error(where + ": observer.velocity_cutoff: expected 1 or " + std::to_string(n) +
-                " values, got " + std::to_string(o.velocity_cutoff.size()));
-  }
+  validate_cutoffs(o.residual_cutoff, "residual_cutoff", where, n);
+  validate_cutoffs(o.velocity_cutoff, "velocity_cutoff", where, n);
   (void)MomentumObserver::checked_inertia_correction(o.inertia_correction, n);
   if (o.friction) validate_friction(*o.friction, n, "MomentumObserver");
   if (o.payload && !finite_inertia(o.payload->inertia)) {
