@@ -292,9 +292,20 @@ void register_contact_benchmarks() {
           run_update(state, arm.model, arm.geometry, o, link6);
         });
   }
+  // The velocity filter (observer.velocity_cutoff, 20 Hz on every joint): the momentum's q̇
+  // through the residual filter's two sections, against the plain update above.
+  for (const Config& c : {kTableI[0], kTableI[4]}) {
+    benchmark::RegisterBenchmark(
+        (std::string("BM_FullUpdate_Ours/") + c.name + "/capsules/velocity_filter").c_str(),
+        [&arm, &link6, c](benchmark::State& state) {
+          EstimatorOptions o = options_for(c, link6);
+          o.velocity_cutoff = VectorX::Constant(1, 20.0);
+          run_update(state, arm.model, arm.geometry, o, link6);
+        });
+  }
   // Everything a calibration brings (issue 10, acceptance 5): tanh friction with per-joint
-  // smoothing and offsets, thresholds that follow |q̇|, the residual filter on joints 1-4 and an
-  // inertia correction; against the plain update above in the same binary.
+  // smoothing and offsets, thresholds that follow |q̇|, the residual and velocity filters on joints
+  // 1-4 and an inertia correction; against the plain update above in the same binary.
   for (const Config& c : {kTableI[0], kTableI[4]}) {
     benchmark::RegisterBenchmark(
         (std::string("BM_FullUpdate_Ours/") + c.name + "/capsules/calibrated").c_str(),
@@ -310,6 +321,7 @@ void register_contact_benchmarks() {
           o.friction = f;
           o.detection.tau_per_speed = VectorX::Constant(1, 0.01);
           o.residual_cutoff = VectorX{{20, 20, 20, 20, 0, 0, 0}};
+          o.velocity_cutoff = VectorX{{20, 20, 20, 20, 0, 0, 0}};
           o.inertia_correction = VectorX::Constant(n, 0.01);
           run_update(state, arm.model, arm.geometry, o, link6);
         });
