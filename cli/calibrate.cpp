@@ -106,8 +106,9 @@ void register_calibrate(CLI::App& app) {
                 "none)");
   sub->add_flag("--inertia", opt->arguments.inertia,
                 "Also fit a correction of the inertia along each joint (observer.inertia_"
-                "correction), kept where it lowers the joint's residual by 10 % or more beyond a "
-                "gravity error; best with observer.residual_cutoff on noisy joints");
+                "correction), kept where it lowers the joint's residual by 10 % or more beyond "
+                "the velocity's noise and a gravity error; best with observer.velocity_cutoff on "
+                "joints whose dq is noisy");
   add_package_path_option(*sub, opt->package_path);
   sub->footer(help_footer(
       {{"extwrench calibrate --config panda.yaml --log free.csv --out calib.yaml --holdout 0.4",

@@ -353,17 +353,34 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
   }
 }
 
-// (B(q_k) q̇_k)_i along the log: the model check compares the residual's fast part with what the
-// observer's momentum passes of the measured velocity's.
+// (B(q_k) q̇_k)_i along the log and its q̇_i: the model check compares the residual's fast part
+// with what the observer's momentum passes of the measured velocity's, and the inertia
+// correction's δI q̇ is added to that q̇.
 void momentum_series(const Model& model, const std::vector<Sample>& samples,
                      const std::vector<VectorX>& momentum_dq, std::vector<JointSeries>& series) {
   Data data(model);
-  for (JointSeries& js : series) js.momentum.assign(samples.size(), 0.0);
+  for (JointSeries& js : series) {
+    js.momentum.assign(samples.size(), 0.0);
+    js.momentum_dq.assign(samples.size(), 0.0);
+  }
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const VectorX& dq = momentum_dq.empty() ? samples[k].dq : momentum_dq[k];
     const VectorX p = crba(model, data, samples[k].q) * dq;
-    for (std::size_t i = 0; i < series.size(); ++i)
+    for (std::size_t i = 0; i < series.size(); ++i) {
       series[i].momentum[k] = p[static_cast<Eigen::Index>(i)];
+      series[i].momentum_dq[k] = dq[static_cast<Eigen::Index>(i)];
+    }
+  }
+}
+
+// The observer's answer to the momentum, its part above ~20 Hz, through the residual filter where
+// the joint has one (its weights already in the series): the velocity's noise as the detector
+// sees it.
+void momentum_fast_series(const std::vector<Sample>& samples, std::vector<JointSeries>& series) {
+  std::vector<double> z;
+  for (JointSeries& js : series) {
+    calibration_detail::filter_rate(js.momentum, js.alpha, js.dt, z, js.filter_weight);
+    js.momentum_fast = calibration_detail::fast_part(z, samples, calibration_detail::kFastWindow);
   }
 }
 
@@ -604,6 +621,7 @@ Calibration calibrate_with(const Model& model, const EstimatorOptions& options,
       js.filter_weight = weight;
     }
   }
+  momentum_fast_series(samples, series);
   cal.sensor_type = options.sensor.type;
   cal.false_alarms_per_hour = o.false_alarms_per_hour;
   cal.t_begin = samples.front().t;

@@ -191,6 +191,22 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y,
   return f;
 }
 
+std::vector<double> fast_part(const std::vector<double>& x, const std::vector<Sample>& samples,
+                              double window) {
+  const std::size_t N = x.size();
+  std::vector<double> prefix(N + 1, 0.0);
+  for (std::size_t k = 0; k < N; ++k) prefix[k + 1] = prefix[k] + x[k];
+  std::vector<double> out(N);
+  std::size_t lo = 0, hi = 0;  // the window is [lo, hi)
+  for (std::size_t k = 0; k < N; ++k) {
+    const double t = samples[k].t;
+    while (samples[lo].t < t - 0.5 * window) ++lo;
+    while (hi < N && samples[hi].t <= t + 0.5 * window) ++hi;
+    out[k] = x[k] - (prefix[hi] - prefix[lo]) / static_cast<double>(hi - lo);
+  }
+  return out;
+}
+
 std::string number_text(double value, int digits) {
   char text[32];
   std::snprintf(text, sizeof text, "%.*g", digits, value == 0.0 ? 0.0 : value);  // no "-0"
@@ -286,7 +302,15 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   filter_regressor(s.dq, s.alpha, z_viscous, s.filter_weight);
   filter_regressor(ones, s.alpha, z_offset, s.filter_weight);
   const bool try_inertia = options.inertia_correction && !s.dt.empty();
-  if (try_inertia) filter_rate(s.dq, s.alpha, s.dt, z_inertia, s.filter_weight);
+  // δI is added to the momentum's q̇ (the velocity filter's, where one is configured); the
+  // velocity's noise that the momentum passes (s.momentum_fast) is a nuisance column of its
+  // fit: central differences of a noisy q̇ follow that noise, and δI would be fitted to cancel
+  // it (−0.26 kg m² on the real Panda's joint 2, which needs none) where the estimator, without
+  // the column, gains nothing.
+  const std::vector<double>& inertia_dq = s.momentum_dq.empty() ? s.dq : s.momentum_dq;
+  const std::vector<double> zeros(s.momentum_fast.empty() ? N : 0, 0.0);  // a column left out
+  const std::vector<double>& z_noise = s.momentum_fast.empty() ? zeros : s.momentum_fast;
+  if (try_inertia) filter_rate(inertia_dq, s.alpha, s.dt, z_inertia, s.filter_weight);
   std::vector<double> smoothings(kSmoothingGrid.begin(), kSmoothingGrid.end());
   if (options.sign == SmoothSign::kDahl)
     smoothings.assign(kPreslidingGrid.begin(), kPreslidingGrid.end());
@@ -294,11 +318,13 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   std::vector<double> shifts{0.0};
   if (options.sign == SmoothSign::kSigmoid) shifts.assign(kShiftGrid.begin(), kShiftGrid.end());
 
-  // The best friction alone, and the best friction with the inertia correction (each with its
-  // own Coulomb smoothing and shift).
+  // The best friction alone; and for the inertia test, the best friction with the noise column
+  // and the best with it and the inertia correction (each with its own Coulomb smoothing and
+  // shift).
   JointFrictionFit best, best_with;
   Solve<3> best_solve;
-  Solve<4> best_solve_with;
+  Solve<4> best_solve_noise;
+  Solve<5> best_solve_with;
   for (const double vs : smoothings) {
     for (const double shift : shifts) {
       coulomb_regressor(s, options.sign, vs, shift, phi);
@@ -311,8 +337,12 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
         best.shift = shift;
       }
       if (!try_inertia) continue;
-      const Solve<4> with = solve_friction<4>({&z_viscous, &z_coulomb, &z_offset, &z_inertia}, s.r0,
-                                              use, options.regularisation);
+      const Solve<4> noise = solve_friction<4>({&z_viscous, &z_coulomb, &z_offset, &z_noise}, s.r0,
+                                               use, options.regularisation);
+      best_solve_noise = noise.rss < best_solve_noise.rss ? noise : best_solve_noise;
+      const Solve<5> with =
+          solve_friction<5>({&z_viscous, &z_coulomb, &z_offset, &z_noise, &z_inertia}, s.r0, use,
+                            options.regularisation);
       if (with.rss < best_solve_with.rss) {
         best_solve_with = with;
         best_with.smoothing = vs;
@@ -333,13 +363,15 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   best.coulomb = best_solve.theta[1];
   best.offset = best_solve.theta[2];
   best.condition = best_solve.condition;
-  // The inertia correction is kept where it explains a clear share of what friction leaves (a
-  // few per cent would be noise fitted), where the regression stays well conditioned, and where
-  // it does so beyond a gravity error too: in a periodic motion q̈ follows q, and an error of
-  // g(q) (of the model's masses, or a payload on the last link) would be taken for an inertia.
-  // The gravity columns are nuisance regressors of this test only.
+  // The inertia correction is kept where it explains a clear share of what friction and the
+  // velocity's noise leave (a few per cent would be noise fitted), where the regression stays
+  // well conditioned, and where it does so beyond a gravity error too: in a periodic motion q̈
+  // follows q, and an error of g(q) (of the model's masses, or a payload on the last link) would
+  // be taken for an inertia. The noise and gravity columns are nuisance regressors of these
+  // tests only (the gravity test without the noise's: with it, the five gravity columns took
+  // the real Panda's joint 4 error, which δI removes on the held-out part too).
   bool keep_inertia = try_inertia && best_solve_with.condition <= kMaxCondition &&
-                      best_solve_with.rss <= (1.0 - kMinInertiaGain) * best_solve.rss;
+                      best_solve_with.rss <= (1.0 - kMinInertiaGain) * best_solve_noise.rss;
   if (keep_inertia && !s.payload_gravity[0].empty()) {
     std::array<std::vector<double>, 5> z_gravity;
     filter_regressor(s.gravity, s.alpha, z_gravity[0], s.filter_weight);
@@ -357,26 +389,40 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                           s.r0, use, options.regularisation);
     keep_inertia = gi.rss <= (1.0 - kMinInertiaGain) * g.rss;
   }
+  const double inertia = best_solve_with.theta[4];
   // One sine per joint: q̈ follows q, and an inertia cannot be told from a gravity error that
   // changes with q_i. Not applied; said, with what motion would tell them apart.
   double correlation = 0.0;
   if (keep_inertia && inertia_aliases_gravity(s, central_acceleration(s), use, correlation)) {
     keep_inertia = false;
     best.warnings.push_back(
-        j + ": an inertia correction (" + number_text(best_solve_with.theta[3], 3) +
+        j + ": an inertia correction (" + number_text(inertia, 3) +
         " kg m^2 fitted) is not applied: in this motion its acceleration follows its position " +
         "(correlation " + number_text(correlation, 3) + ", as with one sine per joint), so it " +
         "cannot be told from a gravity error that changes with the joint's angle (a centre of " +
         "mass off); record a motion that moves " + j + " with several frequencies at once");
   }
   if (keep_inertia) {
-    best_with.viscous = best_solve_with.theta[0];
-    best_with.coulomb = best_solve_with.theta[1];
-    best_with.offset = best_solve_with.theta[2];
-    best_with.inertia = best_solve_with.theta[3];
-    best_with.inertia_gain = 1.0 - best_solve_with.rss / best_solve.rss;
-    best_with.condition = best_solve_with.condition;
-    best = best_with;
+    // The estimator has no noise column: friction refitted with δI held, on r⁰ + δI z_I, and δI
+    // kept only where the residual the estimator will see is smaller than with friction alone
+    // (δI q̇ also adds δI δq̇ of the velocity's noise).
+    std::vector<double> held_r0 = s.r0;
+    for (std::size_t k = 0; k < N; ++k) held_r0[k] += inertia * z_inertia[k];
+    coulomb_regressor(s, options.sign, best_with.smoothing, best_with.shift, phi);
+    filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
+    const Solve<3> held = solve_friction<3>({&z_viscous, &z_coulomb, &z_offset}, held_r0, use,
+                                            options.regularisation);
+    if (held.rss < best_solve.rss) {
+      best_with.viscous = held.theta[0];
+      best_with.coulomb = held.theta[1];
+      best_with.offset = held.theta[2];
+      best_with.inertia = inertia;
+      best_with.inertia_gain = 1.0 - held.rss / best_solve.rss;
+      best_with.condition = best_solve_with.condition;
+      best_with.dahl = best.dahl;
+      best_with.warnings = best.warnings;
+      best = best_with;
+    }
   }
   // A sign fitted to rounding (an ideal simulated log) is not worth a warning.
   if (best_solve.count > 0.0 && std::sqrt(best_solve.rr / best_solve.count) >= kResolvableTorque) {

@@ -28,8 +28,11 @@ inline constexpr double kResolvableTorque = 1e-3;
 struct JointSeries {
   std::vector<double> q, dq, r0, alpha, dt, filter_weight, gravity;
   /// (B(q_k) q̇_k)_i: the momentum the observer forms, of the measured q̇ or of the velocity
-  /// filter's (model check).
-  std::vector<double> momentum;
+  /// filter's; momentum_dq: that q̇_i (the inertia correction's δI q̇ is added to this momentum);
+  /// momentum_fast: the part above ~1/kFastWindow of the observer's answer to the momentum
+  /// (fast_part of filter_rate(momentum)), where a noisy measured velocity enters the residual
+  /// as K B(q) δq̇ (model check, and a nuisance column of the inertia fit).
+  std::vector<double> momentum, momentum_dq, momentum_fast;
   std::array<std::vector<double>, 4> payload_gravity;
   bool axis_along_gravity = false;
 };
@@ -55,6 +58,15 @@ struct JointFrictionFit {
   std::vector<std::string> warnings;
   DahlAlternative dahl;
 };
+
+/// The window [s] of fast_part that separates the velocity's noise (above ~20 Hz) from the
+/// motion, friction and gravity errors (below).
+inline constexpr double kFastWindow = 1.0 / 20.0;
+
+/// x minus its centred mean over the samples within ±window/2 of each time stamp: the part of x
+/// above ~1/window (the mean's first zero), on time stamps that need not be uniform.
+[[nodiscard]] std::vector<double> fast_part(const std::vector<double>& x,
+                                            const std::vector<Sample>& samples, double window);
 
 /// The least-squares line y ≈ intercept + slope x over the samples with use[k] != 0 (centred
 /// sums). r2 = 0 and slope = 0 when fewer than 3 samples or x or y is constant.
@@ -106,9 +118,11 @@ void check_excitation(const JointSeries& s, const std::vector<char>& use, int jo
                       double smoothing);
 
 /// Fits D, F_c, o (and v_s, φ on a grid unless fixed) on the samples with use[k] != 0; with
-/// options.inertia_correction also δI (p += δI q̇), kept where it lowers the residual's sum of
-/// squares by ≥ 10 % also beyond a gravity error (g_i(q) and a last-link payload's gravity as
-/// nuisance regressors, when s.payload_gravity is known).
+/// options.inertia_correction also δI (p += δI q̇ of the momentum's q̇), kept where it lowers the
+/// residual's sum of squares by ≥ 10 % beyond the velocity's noise (s.momentum_fast) and a
+/// gravity error (g_i(q) and a last-link payload's gravity, when s.payload_gravity is known), all
+/// nuisance regressors of that test; the friction is then refitted with δI held, and δI kept
+/// only where that residual is smaller than friction's alone.
 [[nodiscard]] JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                                          const CalibrationOptions& options, int joint);
 

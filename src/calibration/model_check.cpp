@@ -18,7 +18,7 @@ constexpr double kOffsetSpreads = 2.0;
 // this share of the calibrated residual's variance (its spread would drop to ~55 %). White torque
 // noise, which the observer's own first-order law filters, leaves 45 % at K = 100 and more at
 // lower gains: a smaller share is noise that enters after that filter, through K B(q) δq̇.
-constexpr double kSuggestedCutoff = 20.0;  // [Hz]
+constexpr double kSuggestedCutoff = 1.0 / kFastWindow;  // [Hz]
 constexpr double kHighFrequencyLeft = 0.3;
 // Friction that lags the reversals: named when the Dahl sign lowers the friction fit's residual
 // sum of squares by this share (the real Panda's wrist: 29-44 %; a tanh friction's: none).
@@ -27,7 +27,6 @@ constexpr double kMinDahlGain = 0.2;
 // above ~1/kFastWindow (a centred mean over kFastWindow removed) fitted with R² ≥ kNoiseFit and
 // a slope in [kNoiseSlopeMin, kNoiseSlopeMax] around the 1 that a velocity error the torque does
 // not see gives (the real Panda at K = 50: 0.96-0.97, R² 0.95-0.99 on joints 1-4).
-constexpr double kFastWindow = 1.0 / kSuggestedCutoff;  // [s]
 constexpr double kNoiseFit = 0.5;
 constexpr double kNoiseSlopeMin = 0.5;
 constexpr double kNoiseSlopeMax = 1.5;
@@ -85,24 +84,6 @@ double variance(const std::vector<double>& x, const std::vector<char>& use) {
 
 /// RMS of the part of a series of this variance that a fit with this R² explains.
 double explained_rms(double r2, double variance) { return std::sqrt(std::max(r2, 0.0) * variance); }
-
-/// x minus its centred mean over the samples within ±window/2 of each time stamp: the part of x
-/// above ~1/window (the mean's first zero), on time stamps that need not be uniform.
-std::vector<double> fast_part(const std::vector<double>& x, const std::vector<Sample>& samples,
-                              double window) {
-  const std::size_t N = x.size();
-  std::vector<double> prefix(N + 1, 0.0);
-  for (std::size_t k = 0; k < N; ++k) prefix[k + 1] = prefix[k] + x[k];
-  std::vector<double> out(N);
-  std::size_t lo = 0, hi = 0;  // the window is [lo, hi)
-  for (std::size_t k = 0; k < N; ++k) {
-    const double t = samples[k].t;
-    while (samples[lo].t < t - 0.5 * window) ++lo;
-    while (hi < N && samples[hi].t <= t + 0.5 * window) ++hi;
-    out[k] = x[k] - (prefix[hi] - prefix[lo]) / static_cast<double>(hi - lo);
-  }
-  return out;
-}
 
 std::string num(double x) { return number_text(x, 3); }
 
@@ -187,8 +168,7 @@ void check_joints(const std::vector<JointSeries>& series, const std::vector<Join
     // is real is balanced by τ and leaves none. Compared on the fast parts, where the measured
     // velocity is mostly its error and friction or gravity errors have no share.
     const double cutoff = residual_cutoff[static_cast<Eigen::Index>(i)];
-    filter_rate(s.momentum, s.alpha, s.dt, z, s.filter_weight);
-    const std::vector<double> fast_noise = fast_part(z, samples, kFastWindow);
+    const std::vector<double>& fast_noise = s.momentum_fast;
     const LineFit noise =
         fit_line(fast_noise, fast_part(after[i].residual, samples, kFastWindow), use);
     const double noise_share = noise.count > 0 && residual_variance > 0.0

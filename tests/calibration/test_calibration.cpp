@@ -641,6 +641,29 @@ TEST(CalibrationFile, TheInertiaCorrectionIsTheEstimatorsResidual) {
   }
 }
 
+// With the velocity filter, the estimator adds δI to the filtered q̇ of its momentum: the fit's
+// regressor is that q̇'s rate too, so the estimator's residual is still exactly the fit's (with
+// the measured q̇'s, the fitted RMS and the estimator's differ by the noise δI passes), and the
+// rotor is found through the noise.
+TEST(CalibrationFile, TheInertiaCorrectionTakesTheFilteredVelocity) {
+  const Model model = paper_arm();
+  Model rotors = model;
+  rotors.joints[1].armature = 0.25;  // joint 1: vertical axis, no gravity alias
+  auto log = test::simulate_free_motion(rotors, test::free_motion(0.0, 1.0),
+                                        test::paper_arm_friction(), 8.0, Vector6::Zero(), 0.02, 5);
+  test::SeededRng rng(5);
+  for (Sample& s : log) s.dq += rng.uniform_vector(7, -0.004, 0.004);  // a noisy velocity
+  EstimatorOptions options = no_sensor();
+  options.velocity_cutoff = VectorX{{25, 25, 25, 25, 0, 0, 0}};
+  CalibrationOptions with_inertia;
+  with_inertia.inertia_correction = true;
+  const Calibration cal = calibrate(model, options, log, with_inertia);
+  ASSERT_EQ(cal.inertia_correction.size(), 7);
+  EXPECT_NEAR(cal.inertia_correction[0], 0.25, 0.01);
+  EXPECT_GT(cal.joints[0].inertia_gain, 0.3);
+  expect_estimator_residual_is_the_fits(model, apply_calibration(options, cal), log, cal);
+}
+
 // δI is the armature to every stage of the estimator that uses B(q): with a base F/T sensor
 // (route (b): q̈̂ from B + δI, the base wrench's prediction from it) and a push on link 6, the
 // estimator on the model without rotors but with δI = the rotors' armature gives what the

@@ -54,9 +54,9 @@ struct CalibrationOptions {
   double max_contact_fraction = 0.2;    ///< more suspected contact than this: refused
   /// Also fit, per joint, a correction δI of the inertia along the joint in the observer's
   /// momentum (p = B(q) q̇ + δI q̇, EstimatorOptions::inertia_correction) with the friction, kept
-  /// where it lowers the residual's sum of squares by ≥ 10 %, also beyond a gravity error
-  /// (docs/calibration.md#inertia-correction). Opt-in: it lowers thresholds, and on an
-  /// unfiltered noisy residual a threshold lowered from a short log can be crossed later.
+  /// where it lowers the residual's sum of squares by ≥ 10 %, also beyond the velocity's noise
+  /// and a gravity error (docs/calibration.md#inertia-correction). Opt-in: it lowers thresholds
+  /// set from a short log.
   bool inertia_correction = false;
   bool payload = false;  ///< identify a payload on the last link (needs a base F/T sensor)
   /// The samples' true_tau_ext is an external torque known during the recording (a force plate
