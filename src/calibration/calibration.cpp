@@ -353,22 +353,22 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
   }
 }
 
-// (B(q_k) q̇_k)_i along the log and its q̇_i: the model check compares the residual's fast part
-// with what the observer's momentum passes of the measured velocity's, and the inertia
-// correction's δI q̇ is added to that q̇.
+// (B(q_k) q̇_k)_i along the log, and with the velocity filter its q̇_i (without, the series' dq):
+// the model check compares the residual's fast part with what the observer's momentum passes of
+// the measured velocity's, and the inertia correction's δI q̇ is added to that q̇.
 void momentum_series(const Model& model, const std::vector<Sample>& samples,
                      const std::vector<VectorX>& momentum_dq, std::vector<JointSeries>& series) {
   Data data(model);
   for (JointSeries& js : series) {
     js.momentum.assign(samples.size(), 0.0);
-    js.momentum_dq.assign(samples.size(), 0.0);
+    if (!momentum_dq.empty()) js.momentum_dq.assign(samples.size(), 0.0);
   }
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const VectorX& dq = momentum_dq.empty() ? samples[k].dq : momentum_dq[k];
     const VectorX p = crba(model, data, samples[k].q) * dq;
     for (std::size_t i = 0; i < series.size(); ++i) {
       series[i].momentum[k] = p[static_cast<Eigen::Index>(i)];
-      series[i].momentum_dq[k] = dq[static_cast<Eigen::Index>(i)];
+      if (!momentum_dq.empty()) series[i].momentum_dq[k] = dq[static_cast<Eigen::Index>(i)];
     }
   }
 }

@@ -308,8 +308,7 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   // it (−0.26 kg m² on the real Panda's joint 2, which needs none) where the estimator, without
   // the column, gains nothing.
   const std::vector<double>& inertia_dq = s.momentum_dq.empty() ? s.dq : s.momentum_dq;
-  const std::vector<double> zeros(s.momentum_fast.empty() ? N : 0, 0.0);  // a column left out
-  const std::vector<double>& z_noise = s.momentum_fast.empty() ? zeros : s.momentum_fast;
+  const std::vector<double>& z_noise = s.momentum_fast;
   if (try_inertia) filter_rate(inertia_dq, s.alpha, s.dt, z_inertia, s.filter_weight);
   std::vector<double> smoothings(kSmoothingGrid.begin(), kSmoothingGrid.end());
   if (options.sign == SmoothSign::kDahl)
@@ -321,7 +320,8 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
   // The best friction alone; and for the inertia test, the best friction with the noise column
   // and the best with it and the inertia correction (each with its own Coulomb smoothing and
   // shift).
-  JointFrictionFit best, best_with;
+  JointFrictionFit best;
+  double smoothing_with = 0.0, shift_with = 0.0;
   Solve<3> best_solve;
   Solve<4> best_solve_noise;
   Solve<5> best_solve_with;
@@ -345,8 +345,8 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                             options.regularisation);
       if (with.rss < best_solve_with.rss) {
         best_solve_with = with;
-        best_with.smoothing = vs;
-        best_with.shift = shift;
+        smoothing_with = vs;
+        shift_with = shift;
       }
     }
   }
@@ -408,20 +408,19 @@ JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
     // (δI q̇ also adds δI δq̇ of the velocity's noise).
     std::vector<double> held_r0 = s.r0;
     for (std::size_t k = 0; k < N; ++k) held_r0[k] += inertia * z_inertia[k];
-    coulomb_regressor(s, options.sign, best_with.smoothing, best_with.shift, phi);
+    coulomb_regressor(s, options.sign, smoothing_with, shift_with, phi);
     filter_regressor(phi, s.alpha, z_coulomb, s.filter_weight);
     const Solve<3> held = solve_friction<3>({&z_viscous, &z_coulomb, &z_offset}, held_r0, use,
                                             options.regularisation);
     if (held.rss < best_solve.rss) {
-      best_with.viscous = held.theta[0];
-      best_with.coulomb = held.theta[1];
-      best_with.offset = held.theta[2];
-      best_with.inertia = inertia;
-      best_with.inertia_gain = 1.0 - held.rss / best_solve.rss;
-      best_with.condition = best_solve_with.condition;
-      best_with.dahl = best.dahl;
-      best_with.warnings = best.warnings;
-      best = best_with;
+      best.viscous = held.theta[0];
+      best.coulomb = held.theta[1];
+      best.offset = held.theta[2];
+      best.smoothing = smoothing_with;
+      best.shift = shift_with;
+      best.inertia = inertia;
+      best.inertia_gain = 1.0 - held.rss / best_solve.rss;
+      best.condition = best_solve_with.condition;
     }
   }
   // A sign fitted to rounding (an ideal simulated log) is not worth a warning.

@@ -28,8 +28,9 @@ inline constexpr double kResolvableTorque = 1e-3;
 struct JointSeries {
   std::vector<double> q, dq, r0, alpha, dt, filter_weight, gravity;
   /// (B(q_k) q̇_k)_i: the momentum the observer forms, of the measured q̇ or of the velocity
-  /// filter's; momentum_dq: that q̇_i (the inertia correction's δI q̇ is added to this momentum);
-  /// momentum_fast: the part above ~1/kFastWindow of the observer's answer to the momentum
+  /// filter's; momentum_dq: that q̇_i where it is the velocity filter's (empty: dq), the q̇ the
+  /// inertia correction's δI q̇ is added to; momentum_fast (required by fit_joint with
+  /// inertia_correction): the part above ~1/kFastWindow of the observer's answer to the momentum
   /// (fast_part of filter_rate(momentum)), where a noisy measured velocity enters the residual
   /// as K B(q) δq̇ (model check, and a nuisance column of the inertia fit).
   std::vector<double> momentum, momentum_dq, momentum_fast;
@@ -120,9 +121,9 @@ void check_excitation(const JointSeries& s, const std::vector<char>& use, int jo
 /// Fits D, F_c, o (and v_s, φ on a grid unless fixed) on the samples with use[k] != 0; with
 /// options.inertia_correction also δI (p += δI q̇ of the momentum's q̇), kept where it lowers the
 /// residual's sum of squares by ≥ 10 % beyond the velocity's noise (s.momentum_fast) and a
-/// gravity error (g_i(q) and a last-link payload's gravity, when s.payload_gravity is known), all
-/// nuisance regressors of that test; the friction is then refitted with δI held, and δI kept
-/// only where that residual is smaller than friction's alone.
+/// gravity error (g_i(q) and a last-link payload's gravity, when s.payload_gravity is known),
+/// nuisance regressors of those tests only; the friction is then refitted with δI held, and δI
+/// kept only where that residual is smaller than friction's alone.
 [[nodiscard]] JointFrictionFit fit_joint(const JointSeries& s, const std::vector<char>& use,
                                          const CalibrationOptions& options, int joint);
 
