@@ -305,8 +305,21 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
     if (!sensor || !sensor["type"]) {
       y.fail(kv.second, k + ".sensor.type", "missing (ft, force or none)");
     }
+    // Kept as text and read back when the scheme's config.yaml is written: text that does not
+    // read back (a key with control bytes) is refused here, with its line, not there.
     YAML::Emitter out;
     out << kv.second;
+    bool reads_back = out.good();
+    try {
+      if (reads_back) (void)YAML::Load(out.c_str());
+    } catch (const YAML::Exception&) {
+      reads_back = false;
+    }
+    if (!reads_back) {
+      y.fail(kv.second, k,
+             "cannot be written back as YAML (a key or value with control characters or bytes "
+             "that are not UTF-8?)");
+    }
     s.schemes.push_back({name, out.c_str(), kv.second.Mark().line + 1});
   }
 }
