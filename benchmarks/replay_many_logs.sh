@@ -2,8 +2,9 @@
 # Times `extwrench estimate` over 8 logs of 450 000 rows (7.5 min at 1 kHz each, 7 joints + F/T
 # reading + truth), serially (--jobs 1) and two at a time (--jobs 2), and prints both times and
 # their ratio (issue 15, acceptance 3: <= 0.6 on a 2-core machine), with the serial run's CPU
-# time: each replay is already a three-thread pipeline, so on C cores --jobs cannot beat
-# (serial CPU time) / C, printed as the bound. The outputs of both runs must be the same bytes.
+# time: on C cores --jobs cannot beat (serial CPU time) / C, printed as the bound. --jobs N is N
+# cores: with 8 logs, --jobs 1 and 2 run each replay on one thread (no reader or writer thread).
+# The outputs of both runs must be the same bytes.
 # The logs (~220 MB each) are written once into OUT_DIR and reused.
 #   usage: benchmarks/replay_many_logs.sh BENCH_BUILD_DIR OUT_DIR [ROWS] [LOGS]
 set -euo pipefail

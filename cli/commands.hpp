@@ -79,7 +79,7 @@ void print_metrics_row(const std::string& scheme, const std::string& seed, const
                                       double peak_condition);
 
 /// Adds `--jobs N` (N ≥ 1, else a usage error; default app/jobs.hpp's default_jobs(), the
-/// number of cores) to a subcommand; `what` names the jobs ("Logs replayed").
+/// number of cores) to a subcommand; `what` names the jobs ("logs replayed").
 void add_jobs_option(CLI::App& sub, int& jobs, const std::string& what);
 
 /// One example of a command's --help: the command line and what it does.

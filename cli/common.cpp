@@ -149,8 +149,8 @@ void print_metrics_row(const std::string& scheme, const std::string& seed, const
 void add_jobs_option(CLI::App& sub, int& jobs, const std::string& what) {
   jobs = default_jobs();
   sub.add_option("--jobs", jobs,
-                 what + " at once (default: the number of cores, here " + std::to_string(jobs) +
-                     "); the results do not depend on it")
+                 "Cores to use (default: all, here " + std::to_string(jobs) + "): up to N " + what +
+                     " at once; the results do not depend on N")
       ->type_name("N")
       ->check(CLI::Range(1, 1024));
 }

@@ -192,10 +192,10 @@ void run_estimate(const EstimateOptions& opt) {
               << std::flush;
   }
   const std::size_t count = inputs.logs.size();
-  // Jobs = whole replays, each its own three-thread pipeline (reader, estimator, writer;
-  // app/replay.hpp): --jobs N runs N replays at once. A replay's reader and writer already keep
-  // about a second core busy and yield to its estimator (nice), so N replays need no further
-  // split of the cores: the kernel shares them among the 3N threads, none of which spins.
+  // Jobs = whole replays, N at once on --jobs N cores: each its own three-thread pipeline
+  // (reader, estimator, writer; app/replay.hpp) when it has two cores or more, else each on one
+  // thread, so that --jobs N keeps N cores busy, not 1.8 N.
+  const bool pipelined = replays_pipelined(opt.jobs, count);
   const bool serial = opt.jobs == 1 || count == 1;
   std::vector<std::ostringstream> messages(count), printed(count);
   OutputFiles top;  // DIR itself, removed again if every log fails
@@ -207,6 +207,7 @@ void run_estimate(const EstimateOptions& opt) {
         replay.log = inputs.logs[i];
         replay.out_dir = dirs[i];
         replay.progress = serial;  // parallel progress lines would overwrite one another
+        replay.pipelined = pipelined;
         if (count == 1) return estimate_log(config, std::move(replay), description, std::cout);
         replay.messages = &messages[i];
         try {
@@ -245,7 +246,7 @@ void register_estimate(CLI::App& app) {
       ->required()
       ->type_name("LOG.csv");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
-  add_jobs_option(*sub, opt->jobs, "Logs replayed");
+  add_jobs_option(*sub, opt->jobs, "logs replayed");
   sub->add_option("--metrics-from", opt->metrics_from,
                   "Start of the metrics window [s] (default 0.2, after the residual's transient, "
                   "as simulate)")

@@ -154,7 +154,7 @@ void register_simulate(CLI::App& app) {
       ->type_name("SCENARIO.yaml");
   sub->add_option("--out", opt->out, "Output directory (created)")->required()->type_name("DIR");
   sub->add_flag("--no-figures", opt->no_figures, "Do not draw figures (no gnuplot needed)");
-  add_jobs_option(*sub, opt->jobs, "Seeds simulated, then (seed, scheme) replays,");
+  add_jobs_option(*sub, opt->jobs, "seeds simulated, then (seed, scheme) replays,");
   add_figure_format_option(*sub, opt->figure_format);
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);

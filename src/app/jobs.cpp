@@ -13,6 +13,12 @@ int default_jobs() {
   return cores == 0 ? 1 : static_cast<int>(std::min(cores, 1024u));
 }
 
+bool replays_pipelined(int jobs, std::size_t replays) {
+  if (jobs < 2 || replays == 0) return false;
+  const auto cores = static_cast<std::size_t>(jobs);
+  return cores >= 2 * std::min(cores, replays);
+}
+
 std::size_t JobOutcomes::first_failure() const {
   for (std::size_t i = 0; i < errors.size(); ++i)
     if (errors[i]) return i;

@@ -1,7 +1,8 @@
 // The replay's three threads (app/replay.hpp): a reader parses rows into batches of samples, the
 // calling thread runs the estimator, a writer formats and writes the estimates. Batches are
 // allocated once and recycled (memory does not grow with the log); hand-offs are per batch, not
-// per row. Private to the app library.
+// per row. Or, when a replay has one core (`--jobs`), the same interface on the calling thread
+// alone: a row read, estimated and written after the other. Private to the app library.
 #pragma once
 
 #include <sys/resource.h>
@@ -13,6 +14,7 @@
 #include <cstddef>
 #include <exception>
 #include <mutex>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -105,15 +107,23 @@ class BatchRing {
   bool cancelled_ = false;
 };
 
-/// The reader and writer threads around the estimator loop. Rows come out of next() in log
-/// order; a malformed row's error comes out after every row before it, as it would from a
-/// plain loop. Estimates go in through push(). The destructor (also on an exception) writes
-/// every estimate pushed so far, then stops and joins both threads.
+/// The reader and writer threads around the estimator loop (`threaded`), or the plain loop
+/// without them. Rows come out of next() in log order; a malformed row's error comes out after
+/// every row before it, as it would from a plain loop. Estimates go in through push(). The
+/// destructor (also on an exception) writes every estimate pushed so far, then stops and joins
+/// both threads.
 class Pipeline {
  public:
   Pipeline(LogReader& reader, EstimatesWriter& writer, const Sample& sample_prototype,
-           const ContactEstimate& estimate_prototype)
-      : in_(sample_prototype), out_(estimate_prototype) {
+           const ContactEstimate& estimate_prototype, bool threaded) {
+    if (!threaded) {
+      reader_ = &reader;
+      writer_ = &writer;
+      sample_ = sample_prototype;
+      return;
+    }
+    in_.emplace(sample_prototype);
+    out_.emplace(estimate_prototype);
     reader_thread_ = std::thread([this, &reader] { read_rows(reader); });
     try {
       writer_thread_ = std::thread([this, &writer] { write_rows(writer); });
@@ -132,16 +142,17 @@ class Pipeline {
   /// The next sample, valid until the following call; nullptr at the end of the log. Rethrows
   /// the reader's error (a malformed row) at its place in the sequence.
   const Sample* next() {
+    if (reader_ != nullptr) return reader_->next(sample_) ? &sample_ : nullptr;
     for (;;) {
       if (in_batch_ == nullptr) {
-        in_batch_ = in_.acquire_full();  // the reader is only cancelled by our destructor
+        in_batch_ = in_->acquire_full();  // the reader is only cancelled by our destructor
         in_index_ = 0;
         if (in_batch_ == nullptr) return nullptr;
       }
       if (in_index_ < in_batch_->count) return &in_batch_->items[in_index_++];
       const bool last = in_batch_->last;
       const std::exception_ptr error = in_batch_->error;
-      in_.release();
+      in_->release();
       in_batch_ = nullptr;
       if (error) fail(error);
       if (last) return nullptr;
@@ -150,13 +161,14 @@ class Pipeline {
 
   /// Queues an estimate for writing (copied: the estimator overwrites its result).
   void push(const ContactEstimate& e) {
+    if (writer_ != nullptr) return writer_->write(e);
     if (out_batch_ == nullptr) {
-      out_batch_ = out_.acquire_free();
+      out_batch_ = out_->acquire_free();
       if (out_batch_ == nullptr) fail(nullptr);  // the writer failed
     }
     out_batch_->items[out_batch_->count++] = e;
     if (out_batch_->count == kBatchRows) {
-      out_.publish();
+      out_->publish();
       out_batch_ = nullptr;
     }
   }
@@ -171,7 +183,7 @@ class Pipeline {
   void read_rows(LogReader& reader) {
     give_way_to_the_estimator();
     for (;;) {
-      auto* b = in_.acquire_free();
+      auto* b = in_->acquire_free();
       if (b == nullptr) return;  // cancelled: the consumer has stopped
       try {
         while (b->count < kBatchRows) {
@@ -186,7 +198,7 @@ class Pipeline {
         b->last = true;
       }
       const bool last = b->last;
-      in_.publish();
+      in_->publish();
       if (last) return;
     }
   }
@@ -195,16 +207,16 @@ class Pipeline {
     give_way_to_the_estimator();
     try {
       for (;;) {
-        auto* b = out_.acquire_full();
+        auto* b = out_->acquire_full();
         if (b == nullptr) return;
         for (std::size_t k = 0; k < b->count; ++k) writer.write(b->items[k]);
         const bool last = b->last;
-        out_.release();
+        out_->release();
         if (last) return;
       }
     } catch (...) {
       write_error_ = std::current_exception();  // read by the main thread after join()
-      out_.cancel();
+      out_->cancel();
     }
   }
 
@@ -219,10 +231,10 @@ class Pipeline {
 
   void finish_output() {
     if (!writer_thread_.joinable()) return;
-    if (out_batch_ == nullptr) out_batch_ = out_.acquire_free();  // nullptr if the writer failed
+    if (out_batch_ == nullptr) out_batch_ = out_->acquire_free();  // nullptr if the writer failed
     if (out_batch_ != nullptr) {
       out_batch_->last = true;
-      out_.publish();
+      out_->publish();
       out_batch_ = nullptr;
     }
     writer_thread_.join();
@@ -230,18 +242,22 @@ class Pipeline {
 
   void stop_reader() {
     if (!reader_thread_.joinable()) return;
-    in_.cancel();
+    in_->cancel();
     reader_thread_.join();
   }
 
-  BatchRing<Sample> in_;
-  BatchRing<ContactEstimate> out_;
+  std::optional<BatchRing<Sample>> in_;  // threaded only
+  std::optional<BatchRing<ContactEstimate>> out_;
   typename BatchRing<Sample>::Batch* in_batch_ = nullptr;
   std::size_t in_index_ = 0;
   typename BatchRing<ContactEstimate>::Batch* out_batch_ = nullptr;
   std::exception_ptr write_error_;
   std::thread reader_thread_;
   std::thread writer_thread_;
+  // The plain loop (not threaded): reads into sample_, writes directly.
+  LogReader* reader_ = nullptr;
+  EstimatesWriter* writer_ = nullptr;
+  Sample sample_;
 };
 
 }  // namespace extwrench::detail

@@ -206,7 +206,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
   ContactTally contacts(model.num_bodies());
   const std::string log_name = reader.name();  // the reader belongs to its thread from here on
-  detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype());
+  detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype(), o.pipelined);
   while (const Sample* sample = pipeline.next()) {
     const Sample& s = *sample;
     const ContactEstimate& e = estimator.update(s);

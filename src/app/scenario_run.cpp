@@ -247,6 +247,7 @@ SchemeResult replay_scheme(const Scenario& s, const SeedJob& seed, std::size_t s
   ro.figure_format = options.figure_format;
   ro.desired_trajectory = &s.trajectory;
   ro.progress = progress;
+  ro.pipelined = replays_pipelined(options.jobs, s.seeds.size() * s.schemes.size());
   ro.warn_ignored_columns = false;
   ro.outputs = &outputs;
   ro.messages = &messages;

@@ -77,5 +77,17 @@ TEST(Jobs, FewerThanOneJobIsRefused) {
   EXPECT_GE(default_jobs(), 1);
 }
 
+TEST(Jobs, AReplayGetsItsReaderAndWriterThreadsOnlyWithTwoCoresOfItsOwn) {
+  // --jobs N is N cores: a pipelined replay keeps about two busy.
+  EXPECT_FALSE(replays_pipelined(1, 1));  // one core: one thread
+  EXPECT_TRUE(replays_pipelined(2, 1));
+  EXPECT_FALSE(replays_pipelined(2, 8));  // two replays at once, one core each
+  EXPECT_FALSE(replays_pipelined(3, 2));
+  EXPECT_TRUE(replays_pipelined(4, 2));
+  EXPECT_TRUE(replays_pipelined(16, 8));
+  EXPECT_FALSE(replays_pipelined(15, 8));
+  EXPECT_FALSE(replays_pipelined(4, 0));
+}
+
 }  // namespace
 }  // namespace extwrench

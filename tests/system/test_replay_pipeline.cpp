@@ -1,6 +1,7 @@
-// replay_log runs in three threads (reader, estimator, writer) handing batches of rows along.
-// Checked against the plain loop it replaced, run here on one thread: the same bytes in
-// estimates.csv, the same error text after the same rows, however the rows fall in batches.
+// replay_log runs in three threads (reader, estimator, writer) handing batches of rows along, or
+// on one (ReplayOptions::pipelined false, a replay given one core). Both checked against the
+// plain loop, run here: the same bytes in estimates.csv, the same error text after the same
+// rows, however the rows fall in batches.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -153,12 +154,13 @@ Outcome plain_loop(const RobotDescription& robot, const EstimatorOptions& option
   return o;
 }
 
-Outcome pipelined(const RobotDescription& robot, const EstimatorOptions& options,
-                  const fs::path& log, const fs::path& out_dir) {
+Outcome replayed(const RobotDescription& robot, const EstimatorOptions& options,
+                 const fs::path& log, const fs::path& out_dir, bool pipelined) {
   ReplayOptions ro;
   ro.log = log;
   ro.out_dir = out_dir;
   ro.figures = false;
+  ro.pipelined = pipelined;
   Outcome o;
   try {
     const ReplayResult r = replay_log(robot.model, robot.geometry, options, ro);
@@ -187,14 +189,18 @@ TEST_F(ReplayPipeline, WritesTheSameBytesAsThePlainLoopWhateverTheNumberOfBatche
     write_log(log, rows, true);
     const fs::path out = dir_ / ("same_" + std::to_string(rows));
     const Outcome expected = plain_loop(*robot_, ft_options(), log, out / "plain");
-    const Outcome got = pipelined(*robot_, ft_options(), log, out / "pipelined");
     ASSERT_EQ(expected.error, "") << rows;
-    EXPECT_EQ(got.error, "") << rows;
-    EXPECT_EQ(lines_of(got.estimates), rows + 1);
-    EXPECT_TRUE(got.estimates == expected.estimates) << rows << " rows: estimates differ";
-    // Several status texts went through the writer's cache.
-    EXPECT_NE(got.estimates.find(",free,"), std::string::npos);
-    EXPECT_NE(got.estimates.find("contact|"), std::string::npos);
+    for (const bool pipelined : {true, false}) {
+      const Outcome got = replayed(*robot_, ft_options(), log,
+                                   out / (pipelined ? "pipelined" : "one_thread"), pipelined);
+      EXPECT_EQ(got.error, "") << rows;
+      EXPECT_EQ(lines_of(got.estimates), rows + 1);
+      EXPECT_TRUE(got.estimates == expected.estimates)
+          << rows << " rows, pipelined " << pipelined << ": estimates differ";
+      // Several status texts went through the writer's cache.
+      EXPECT_NE(got.estimates.find(",free,"), std::string::npos);
+      EXPECT_NE(got.estimates.find("contact|"), std::string::npos);
+    }
   }
 }
 
@@ -203,10 +209,13 @@ TEST_F(ReplayPipeline, LogWithoutVelocitiesIsDifferentiatedAcrossBatchesAsInTheP
   write_log(log, 2 * kBatch + 17, false);
   EstimatorOptions options;  // no sensor: the other update()
   const Outcome expected = plain_loop(*robot_, options, log, dir_ / "no_dq" / "plain");
-  const Outcome got = pipelined(*robot_, options, log, dir_ / "no_dq" / "pipelined");
   ASSERT_EQ(expected.error, "");
-  EXPECT_EQ(got.error, "");
-  EXPECT_TRUE(got.estimates == expected.estimates) << "estimates differ";
+  for (const bool pipelined : {true, false}) {
+    const Outcome got =
+        replayed(*robot_, options, log, dir_ / "no_dq" / std::to_string(pipelined), pipelined);
+    EXPECT_EQ(got.error, "");
+    EXPECT_TRUE(got.estimates == expected.estimates) << "pipelined " << pipelined;
+  }
 }
 
 TEST_F(ReplayPipeline, MalformedRowFailsWithTheSameTextAfterTheSameRowsAsThePlainLoop) {
@@ -232,11 +241,14 @@ TEST_F(ReplayPipeline, MalformedRowFailsWithTheSameTextAfterTheSameRowsAsThePlai
     const fs::path log = dir_ / (name + ".csv");
     corrupt_row(good, log, c.row, row_with_cell(good, c.row, c.cell, c.value));
     const Outcome expected = plain_loop(*robot_, ft_options(), log, dir_ / name / "plain");
-    const Outcome got = pipelined(*robot_, ft_options(), log, dir_ / name / "pipelined");
     EXPECT_NE(expected.error.find(c.expected), std::string::npos) << expected.error;
-    EXPECT_EQ(got.error, expected.error);
-    // A failed replay leaves no output, not even the rows before the bad one (docs/cli.md).
-    EXPECT_FALSE(fs::exists(dir_ / name / "pipelined")) << c.row;
+    for (const bool pipelined : {true, false}) {
+      const fs::path out = dir_ / name / std::to_string(pipelined);
+      const Outcome got = replayed(*robot_, ft_options(), log, out, pipelined);
+      EXPECT_EQ(got.error, expected.error);
+      // A failed replay leaves no output, not even the rows before the bad one (docs/cli.md).
+      EXPECT_FALSE(fs::exists(out)) << c.row << ", pipelined " << pipelined;
+    }
   }
 }
 
@@ -249,37 +261,43 @@ TEST_F(ReplayPipeline, MalformedSecondRowOfALogWithoutVelocitiesFailsBeforeAnyRo
   corrupt_row(good, log, 1, row_with_cell(good, 1, 3, "x"));
   const Outcome expected =
       plain_loop(*robot_, EstimatorOptions{}, log, dir_ / "no_dq_bad" / "plain");
-  const Outcome got = pipelined(*robot_, EstimatorOptions{}, log, dir_ / "no_dq_bad" / "pipelined");
-  EXPECT_NE(got.error.find(":3: column 4 'q3': expected a number, got 'x'"), std::string::npos)
-      << got.error;
-  EXPECT_EQ(got.error, expected.error);
-  EXPECT_FALSE(fs::exists(dir_ / "no_dq_bad" / "pipelined"));
+  for (const bool pipelined : {true, false}) {
+    const fs::path out = dir_ / "no_dq_bad" / std::to_string(pipelined);
+    const Outcome got = replayed(*robot_, EstimatorOptions{}, log, out, pipelined);
+    EXPECT_NE(got.error.find(":3: column 4 'q3': expected a number, got 'x'"), std::string::npos)
+        << got.error;
+    EXPECT_EQ(got.error, expected.error);
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 TEST_F(ReplayPipeline, AFailedWriteStopsTheReplayWithTheWritersError) {
-  // estimates.csv on a full disk: the writer thread fails at its first flush, while the reader
-  // still has rows; the error must come out, not a hang.
+  // estimates.csv on a full disk: the writer fails at its first flush, while the reader still
+  // has rows; the error must come out, not a hang.
   if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
   const fs::path log = dir_ / "for_full_disk.csv";
   write_log(log, 4 * kBatch, true);  // ~1.5 MB of estimates: the first 1 MiB flush fails mid-log
-  const fs::path out = dir_ / "full_disk";
-  fs::create_directories(out);
-  // The replay writes estimates.csv.partial, renamed when complete.
-  fs::create_symlink("/dev/full", out / "estimates.csv.partial");
-  ReplayOptions ro;
-  ro.log = log;
-  ro.out_dir = out;
-  ro.figures = false;
-  std::string error;
-  try {
-    (void)replay_log(robot_->model, robot_->geometry, ft_options(), ro);
-  } catch (const Error& e) {
-    error = e.what();
+  for (const bool pipelined : {true, false}) {
+    const fs::path out = dir_ / "full_disk" / std::to_string(pipelined);
+    fs::create_directories(out);
+    // The replay writes estimates.csv.partial, renamed when complete.
+    fs::create_symlink("/dev/full", out / "estimates.csv.partial");
+    ReplayOptions ro;
+    ro.log = log;
+    ro.out_dir = out;
+    ro.figures = false;
+    ro.pipelined = pipelined;
+    std::string error;
+    try {
+      (void)replay_log(robot_->model, robot_->geometry, ft_options(), ro);
+    } catch (const Error& e) {
+      error = e.what();
+    }
+    EXPECT_NE(error.find("estimates.csv.partial: write failed"), std::string::npos) << error;
+    // Nothing of the failed replay remains.
+    EXPECT_FALSE(fs::exists(out / "estimates.csv"));
+    EXPECT_FALSE(fs::is_symlink(out / "estimates.csv.partial"));
   }
-  EXPECT_NE(error.find("estimates.csv.partial: write failed"), std::string::npos) << error;
-  // Nothing of the failed replay remains.
-  EXPECT_FALSE(fs::exists(out / "estimates.csv"));
-  EXPECT_FALSE(fs::is_symlink(out / "estimates.csv.partial"));
 }
 
 }  // namespace

@@ -16,6 +16,12 @@ namespace extwrench {
 /// 1 when unknown.
 [[nodiscard]] int default_jobs();
 
+/// Whether replays run on `jobs` cores get their own reader and writer threads
+/// (ReplayOptions::pipelined): when min(jobs, replays) of them run at once and each has at least
+/// two cores. A pipelined replay keeps about 1.8 cores busy; `--jobs N` means N cores, so one
+/// core per replay (--jobs 1, or more logs than cores) runs each on its own thread alone.
+[[nodiscard]] bool replays_pipelined(int jobs, std::size_t replays);
+
 struct JobsOptions {
   int jobs = 1;  ///< threads running jobs at once (≥ 1; 1: in the calling thread, in order)
   /// After a failure, start no job of a higher index (the jobs of lower indices have already

@@ -2,7 +2,8 @@
 // of `extwrench simulate`, which replays the log it just wrote through the very same code.
 // Streaming: memory does not depend on the log's length (figures are decimated). Three threads
 // share the work: one reads and parses the log, the calling thread estimates, one formats and
-// writes estimates.csv; they hand rows along in batches recycled through fixed rings.
+// writes estimates.csv; they hand rows along in batches recycled through fixed rings. A replay
+// given one core (ReplayOptions::pipelined false) does all three on the calling thread.
 #pragma once
 
 #include <filesystem>
@@ -37,9 +38,13 @@ struct ReplayOptions {
   FigureFormat figure_format = FigureFormat::kPng;
   /// The trajectory the log's controller tracked (simulate): q_d in the joint figure; or null.
   const sim::SinusoidalTrajectory* desired_trajectory = nullptr;
-  int plot_points = 2000;            ///< decimation target per figure
-  int snapshots = 4;                 ///< instants of the 3-D view
-  bool progress = false;             ///< progress line on stderr
+  int plot_points = 2000;  ///< decimation target per figure
+  int snapshots = 4;       ///< instants of the 3-D view
+  bool progress = false;   ///< progress line on stderr
+  /// Parse the log and write estimates.csv on two threads of their own beside the calling,
+  /// estimating one (about 1.8 cores busy); false: all three on the calling thread, for a
+  /// replay given one core (`--jobs`, replays_pipelined). The bytes written are the same.
+  bool pipelined = true;
   bool warn_ignored_columns = true;  ///< list unknown log columns once on stderr
   /// Joint columns beyond the robot's n (q8 on a 7-joint robot) are an error unless this is set
   /// (then they are ignored, with the note of warn_ignored_columns).
