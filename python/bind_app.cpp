@@ -77,6 +77,7 @@ py::list joints_list(const std::vector<JointFitReport>& joints) {
     d["rms_after"] = j.rms_after;
     d["max_before"] = j.max_before;
     d["max_after"] = j.max_after;
+    d["max_after_t"] = j.max_after_t;
     d["variance_explained"] = j.variance_explained;
     d["noise_std"] = j.noise_std;
     d["crossing_rate"] = j.crossing_rate;

@@ -128,7 +128,10 @@ std::string calibration_report(const CalibrateLogResult& run, bool in_contact) {
     if (j.speed_dependent)
       out << " + " << cell(j.threshold_per_speed, 0) << " |dq| (constant would be "
           << cell(j.threshold_constant, 0) << ")";
-    out << (j.threshold_from_max ? " (largest residual)" : " (gaussian)") << "\n";
+    if (j.threshold_from_max)
+      out << " (largest residual, at t = " << cell(j.max_after_t, 0) << " s)\n";
+    else
+      out << " (gaussian)\n";
   }
   if ((c.residual_cutoff.array() > 0.0).any()) {
     out << "  residual filter [Hz]:";

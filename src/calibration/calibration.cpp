@@ -184,18 +184,22 @@ std::vector<SuspectWindow> suspect_windows(const std::vector<JointFrictionFit>& 
 void joint_threshold(const std::vector<double>& r, const std::vector<Sample>& samples,
                      const std::vector<char>& use, double rate, double margin, JointFitReport& j) {
   double sum = 0.0, sum2 = 0.0, peak = 0.0, duration = 0.0;
-  std::size_t count = 0;
+  std::size_t count = 0, peak_at = 0;
   for (std::size_t k = 0; k < r.size(); ++k) {
     if (!use[k]) continue;
     sum += r[k];
     sum2 += r[k] * r[k];
-    peak = std::max(peak, std::abs(r[k]));
+    if (std::abs(r[k]) > peak) {
+      peak = std::abs(r[k]);
+      peak_at = k;
+    }
     ++count;
   }
   const double mean = sum / static_cast<double>(count);
   j.noise_std = std::sqrt(std::max(sum2 / static_cast<double>(count) - mean * mean, 0.0));
   j.rms_after = std::sqrt(sum2 / static_cast<double>(count));
   j.max_after = peak;
+  j.max_after_t = samples[peak_at].t;
   std::size_t crossings = 0;
   for (std::size_t k = 1; k < r.size(); ++k) {
     if (!use[k] || !use[k - 1]) continue;

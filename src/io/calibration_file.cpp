@@ -96,9 +96,10 @@ std::string joint_table(const Calibration& c) {
     const JointFitReport& j = c.joints[i];
     y << "    - {joint: " << i + 1 << ", rms_before: " << j.rms_before
       << ", rms_after: " << j.rms_after << ", max_before: " << j.max_before
-      << ", max_after: " << j.max_after << ", variance_explained: " << j.variance_explained
-      << ", noise_std: " << j.noise_std << ", crossing_rate: " << j.crossing_rate
-      << ", condition: " << j.condition << ", threshold: " << j.threshold
+      << ", max_after: " << j.max_after << ", max_after_t: " << j.max_after_t
+      << ", variance_explained: " << j.variance_explained << ", noise_std: " << j.noise_std
+      << ", crossing_rate: " << j.crossing_rate << ", condition: " << j.condition
+      << ", threshold: " << j.threshold
       << ", threshold_rule: " << (j.threshold_from_max ? "largest_residual" : "gaussian")
       << ", noise_at_rest: " << j.noise_at_rest << ", noise_per_speed: " << j.noise_per_speed
       << ", threshold_constant: " << j.threshold_constant

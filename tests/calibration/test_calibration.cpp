@@ -48,25 +48,39 @@ EstimatorConfig config_including(const Calibration& cal, const char* dir_name) {
       dir / "config.yaml");
 }
 
-// The RMS per joint of the residual of a MomentumObserver (K = 50) run over `log` with the
-// calibrated friction, over the samples the calibration used (after its settle time, 5 / K).
-VectorX observer_rms_after_settling(const Model& model, const Calibration& cal,
-                                    const std::vector<Sample>& log) {
+// The residual of a MomentumObserver (K = 50) run over `log` with the calibrated friction, over
+// the samples the calibration used (after its settle time, 5 / K), per joint: its RMS, its largest
+// magnitude and when that came.
+struct ObserverResidual {
+  VectorX rms, peak, peak_t;
+};
+ObserverResidual observer_after_settling(const Model& model, const Calibration& cal,
+                                         const std::vector<Sample>& log) {
   Data data(model);
   MomentumObserver observer(model, 50.0);
   observer.set_friction(cal.friction);
   EXPECT_TRUE(observer.reset(model, data, log[0].t, log[0].q, log[0].dq, log[0].tau).ok());
-  VectorX sum2 = VectorX::Zero(model.nq());
+  const int n = model.nq();
+  VectorX sum2 = VectorX::Zero(n);
+  ObserverResidual out{
+      .rms = VectorX::Zero(n), .peak = VectorX::Zero(n), .peak_t = VectorX::Zero(n)};
   int count = 0;
   for (std::size_t k = 1; k < log.size(); ++k) {
     EXPECT_TRUE(observer.update(model, data, log[k].t, log[k].q, log[k].dq, log[k].tau).ok());
     EXPECT_LE(observer.presliding_state().cwiseAbs().maxCoeff(), 1.0);
     if (log[k].t < 5.0 / 50.0 - 1e-9) continue;
     sum2 += observer.residual().cwiseAbs2();
+    for (int i = 0; i < n; ++i) {
+      if (std::abs(observer.residual()[i]) > out.peak[i]) {
+        out.peak[i] = std::abs(observer.residual()[i]);
+        out.peak_t[i] = log[k].t;
+      }
+    }
     ++count;
   }
   EXPECT_EQ(count, cal.samples_used);
-  return (sum2 / std::max(count, 1)).cwiseSqrt();
+  out.rms = (sum2 / std::max(count, 1)).cwiseSqrt();
+  return out;
 }
 
 // Gaz et al. (2019): τ_f = A / (1 + e^{−α (q̇ + φ)}) − A / (1 + e^{−α φ}), here with A = 2 F_c
@@ -180,7 +194,7 @@ TEST(Calibration, DahlFrictionIsIdentifiedWhereAVelocitySignCannotFollowIt) {
   EXPECT_EQ(cal_fixed.friction.coulomb, cal.friction.coulomb);
   // The observer with the fitted Dahl friction (its own state, from the positions) leaves the
   // residual the fit reports.
-  const VectorX rms = observer_rms_after_settling(model, cal, log);
+  const VectorX rms = observer_after_settling(model, cal, log).rms;
   for (int i = 0; i < 7; ++i)
     EXPECT_NEAR(rms[i], cal.joints[static_cast<std::size_t>(i)].rms_after, 1e-9);
   // Through CALIB.yaml: written, included by a configuration, the same friction.
@@ -198,12 +212,17 @@ TEST(Calibration, FitResidualIsTheObserverResidualWithTheFittedFriction) {
   const Model model = paper_arm();
   const auto log = free_log(12.0);
   const Calibration cal = calibrate(model, no_sensor(), log);
-  const VectorX rms = observer_rms_after_settling(model, cal, log);
+  const ObserverResidual r = observer_after_settling(model, cal, log);
   for (int i = 0; i < 7; ++i) {
-    EXPECT_NEAR(rms[i], cal.joints[static_cast<std::size_t>(i)].rms_after, 1e-9);
-    EXPECT_LT(cal.joints[static_cast<std::size_t>(i)].rms_after,
-              0.2 * cal.joints[static_cast<std::size_t>(i)].rms_before);
+    const JointFitReport& j = cal.joints[static_cast<std::size_t>(i)];
+    EXPECT_NEAR(r.rms[i], j.rms_after, 1e-9);
+    EXPECT_LT(j.rms_after, 0.2 * j.rms_before);
+    // The largest residual and its time, which the report gives beside a threshold it sets.
+    EXPECT_NEAR(r.peak[i], j.max_after, 1e-9);
+    EXPECT_EQ(r.peak_t[i], j.max_after_t) << "joint " << i + 1;
   }
+  // A moment in the log, not the first sample's default.
+  EXPECT_GT(r.peak_t.maxCoeff(), 1.0);
 }
 
 TEST(CalibrationInput, ShortContactIsExcludedAndNamedWithItsWindow) {

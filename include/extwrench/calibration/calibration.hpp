@@ -81,10 +81,13 @@ struct PayloadReport {
 
 /// Fit quality of one joint, over the samples used.
 struct JointFitReport {
-  double rms_before = 0.0;          ///< residual RMS with the configured friction [N m]
-  double rms_after = 0.0;           ///< residual RMS after calibration [N m]
-  double max_before = 0.0;          ///< max |residual| with the configured friction
-  double max_after = 0.0;           ///< max |residual| after calibration
+  double rms_before = 0.0;  ///< residual RMS with the configured friction [N m]
+  double rms_after = 0.0;   ///< residual RMS after calibration [N m]
+  double max_before = 0.0;  ///< max |residual| with the configured friction
+  double max_after = 0.0;   ///< max |residual| after calibration
+  /// When max_after occurred (the log's t) [s]: the moment that sets a largest_residual
+  /// threshold, e.g. a start from rest, which a later stretch of the same motion may not repeat.
+  double max_after_t = 0.0;
   double variance_explained = 0.0;  ///< 1 − var(after) / var(before)
   double noise_std = 0.0;           ///< standard deviation of the residual after calibration
   double crossing_rate = 0.0;       ///< up-crossings of its mean per second (Rice's ν₀) [1/s]
