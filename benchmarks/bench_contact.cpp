@@ -14,7 +14,11 @@
 #include <vector>
 
 #include "extwrench/core/denormals.hpp"
+#include "extwrench/dynamics/crba.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
+#include "extwrench/estimation/damped_least_squares.hpp"
+#include "extwrench/observer/momentum_observer.hpp"
 #include "robots.hpp"
 
 namespace extwrench::bench {
@@ -183,6 +187,54 @@ BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, subnormal, 1e-310, false);
 BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, underflowing, 1e-300, false);
 BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, subnormal_flushed, 1e-310, true);
 BENCHMARK_CAPTURE(BM_FullUpdate_TinyVelocity, underflowing_flushed, 1e-300, true);
+
+// Where the full update's time goes (issue 15): its first stages, cumulatively, with the public
+// functions ContactEstimator::update calls, on the samples of BM_FullUpdate_Ours/ft/pure_force/
+// capsules (the link-6 trajectory, K = 100). 1: the fused momentum + bias pass (poses, B q̇,
+// Cᵀq̇, g, the world-frame inertias, c(q, q̇)); 2: + the input checks and the observer's
+// integration; 3: + q̈̂ = B⁻¹ (τ − τ_f + r − c) (CRBA, LDLᵀ). The full update's median minus
+// stage 3's is stages 4–10: ground wrench, sensor, release, detection, isolation, the Table I
+// case, the point, the uncertainty.
+void BM_UpdateStages_Ours(benchmark::State& state, int last_stage) {
+  const PaperArm& arm = paper_arm();
+  const Model& model = arm.model;
+  const Trajectory& tr = link6_trajectory();
+  Data data(model);
+  MomentumObserver observer(model, kGain);
+  if (!observer.reset(model, data, 0.0, tr.q[0], tr.dq[0], tr.tau[0]).ok()) {
+    state.SkipWithError("observer reset failed");
+    return;
+  }
+  const int n = model.nq();
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 12, 12> mass_ldlt(n, n);
+  VectorX ddq = VectorX::Zero(n);
+  std::size_t k = 1;
+  auto step = [&] {
+    const std::size_t s = sample(k);
+    const double t = stamp(k, tr);
+    ++k;
+    if (last_stage >= 2) {
+      const Status st = observer.validate(t, tr.q[s], tr.dq[s], tr.tau[s]);
+      benchmark::DoNotOptimize(st);
+    }
+    momentum_and_bias_terms(model, data, tr.q[s], tr.dq[s]);
+    if (last_stage >= 2) observer.integrate(data, t, tr.q[s], tr.dq[s], tr.tau[s], tr.dq[s]);
+    if (last_stage >= 3) {
+      crba_no_kinematics(model, data);
+      ddq = tr.tau[s] - observer.friction_torque() + observer.residual() - data.tau;
+      mass_ldlt = data.M;
+      if (ldlt_in_place(mass_ldlt)) ldlt_solve(mass_ldlt, ddq);
+      benchmark::DoNotOptimize(ddq.data());
+    }
+    benchmark::DoNotOptimize(data.tau.data());
+    benchmark::ClobberMemory();
+  };
+  for (auto _ : state) step();
+  state.counters["allocs"] = allocations_per_call([&](int) { step(); });
+}
+BENCHMARK_CAPTURE(BM_UpdateStages_Ours, 1_momentum_and_bias, 1);
+BENCHMARK_CAPTURE(BM_UpdateStages_Ours, 2_observer, 2);
+BENCHMARK_CAPTURE(BM_UpdateStages_Ours, 3_acceleration, 3);
 
 /// Minor and major page faults of the calling thread so far.
 long thread_page_faults() {
