@@ -73,13 +73,21 @@ template <typename Matrix>
 /// after another.
 template <typename Matrix, typename Columns>
 inline void ldlt_solve_columns(const Matrix& LD, Columns& X) noexcept {
+  static_assert(Columns::ColsAtCompileTime != Eigen::Dynamic, "needs a fixed number of columns");
+  // Each row is accumulated in registers and stored once: updated in place, every step would
+  // store it and load it back (the compiler cannot tell X's rows apart).
+  using Row = Eigen::Matrix<double, 1, Columns::ColsAtCompileTime>;
   const int n = static_cast<int>(LD.rows());
   for (int i = 1; i < n; ++i) {
-    for (int k = 0; k < i; ++k) X.row(i) -= LD(i, k) * X.row(k);
+    Row row = X.row(i);
+    for (int k = 0; k < i; ++k) row -= LD(i, k) * X.row(k);
+    X.row(i) = row;
   }
   for (int i = 0; i < n; ++i) X.row(i) *= LD(i, i);
   for (int i = n - 2; i >= 0; --i) {
-    for (int k = i + 1; k < n; ++k) X.row(i) -= LD(k, i) * X.row(k);
+    Row row = X.row(i);
+    for (int k = i + 1; k < n; ++k) row -= LD(k, i) * X.row(k);
+    X.row(i) = row;
   }
 }
 
@@ -88,11 +96,15 @@ template <typename Matrix, typename Vector>
 inline void ldlt_solve(const Matrix& LD, Vector& x) noexcept {
   const int n = static_cast<int>(LD.rows());
   for (int i = 1; i < n; ++i) {
-    for (int k = 0; k < i; ++k) x[i] -= LD(i, k) * x[k];
+    double xi = x[i];  // in a register, stored once (as in ldlt_solve_columns)
+    for (int k = 0; k < i; ++k) xi -= LD(i, k) * x[k];
+    x[i] = xi;
   }
   for (int i = 0; i < n; ++i) x[i] *= LD(i, i);
   for (int i = n - 2; i >= 0; --i) {
-    for (int k = i + 1; k < n; ++k) x[i] -= LD(k, i) * x[k];
+    double xi = x[i];
+    for (int k = i + 1; k < n; ++k) xi -= LD(k, i) * x[k];
+    x[i] = xi;
   }
 }
 
