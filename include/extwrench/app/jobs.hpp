@@ -18,8 +18,9 @@ namespace extwrench {
 
 /// Whether replays run on `jobs` cores get their own reader and writer threads
 /// (ReplayOptions::pipelined): when min(jobs, replays) of them run at once and each has at least
-/// two cores. A pipelined replay keeps about 1.8 cores busy; `--jobs N` means N cores, so one
-/// core per replay (--jobs 1, or more logs than cores) runs each on its own thread alone.
+/// two cores. A pipelined replay keeps about 1.8 cores busy; `--jobs N` means N cores, so with
+/// fewer than two cores per replay (--jobs 1, or more than jobs / 2 replays) each runs on its
+/// own thread alone.
 [[nodiscard]] bool replays_pipelined(int jobs, std::size_t replays);
 
 struct JobsOptions {
