@@ -31,6 +31,12 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("compiler", "gcc " __VERSION__);
 #endif
   benchmark::AddCustomContext("flags", EXTWRENCH_BENCH_FLAGS);
+  // Debian builds libbenchmark without NDEBUG, and the library then prints a warning about its
+  // own build below the context: say which build it means, next to the flags of ours.
+  benchmark::AddCustomContext("timing_library",
+                              "a '***WARNING*** Library was built as DEBUG' below is about "
+                              "libbenchmark itself (Debian's package), not about the code "
+                              "measured: that is built with the flags above");
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;
