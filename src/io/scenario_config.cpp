@@ -408,7 +408,7 @@ Obstacle parse_obstacle(const YamlReader& y, const YAML::Node& node, const std::
   return o;
 }
 
-// engine: rigid | mujoco, and the obstacles of a MuJoCo scene.
+// engine: rigid | mujoco, and the obstacles and <option> attributes of a MuJoCo scene.
 void parse_engine(const YamlReader& y, const YAML::Node& root, Scenario& s) {
   if (const YAML::Node e = root["engine"]) {
     s.engine = y.one_of(e, "engine", {"rigid", "mujoco"}) == 1 ? Scenario::Engine::kMujoco
@@ -425,6 +425,19 @@ void parse_engine(const YamlReader& y, const YAML::Node& root, Scenario& s) {
     y.fail(root["locked_joints"], "locked_joints",
            "not with engine: mujoco (MuJoCo simulates every joint of the MJCF; give a file "
            "without the joints, e.g. the Panda without its hand)");
+  }
+  if (const YAML::Node option = root["mujoco_option"]) {
+    if (s.engine != Scenario::Engine::kMujoco)
+      y.fail(option, "mujoco_option", "an option of MuJoCo's: set 'engine: mujoco'");
+    y.only_keys(option, "mujoco_option", {"cone", "impratio"});
+    if (option["cone"]) {
+      s.mujoco_option.cone = static_cast<MujocoOption::Cone>(
+          y.one_of(option["cone"], "mujoco_option.cone", {"pyramidal", "elliptic"}));
+    }
+    if (option["impratio"]) {
+      s.mujoco_option.impratio = y.number_in(option["impratio"], "mujoco_option.impratio",
+                                             {0.0, 1e6, true, "in (0, 1e6]"});
+    }
   }
   const YAML::Node obstacles = root["obstacles"];
   if (!obstacles) return;
@@ -452,7 +465,7 @@ Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& rob
   y.only_keys(root, "",
               {"robot", "locked_joints", "seed", "seeds", "duration", "sample_time", "substeps",
                "model_error", "trajectory", "controller", "forces", "sensors", "metrics", "figures",
-               "schemes", "engine", "obstacles"});
+               "schemes", "engine", "obstacles", "mujoco_option"});
   Scenario s;
   s.source = path;
   parse_robot(y, root, robot_options, s);

@@ -17,12 +17,17 @@
 // - false alarms: samples with a declared contact while MuJoCo reports none, from 0.2 s and
 //   more than 50 ms after the last contact (0).
 //
+// The scenes use MuJoCo's elliptic friction cone (`mujoco_option: {cone: elliptic}`): with its
+// default pyramid, the paper arm's link7 sliding on the post's edge chattered (23 of 404 samples
+// without contact, the force jumping 4.6 N RMS from one sample to the next, against 5 and 1.0 N
+// with the Coulomb cone itself), a simulator artefact that no estimator follows.
 // Where a figure is not met, the case below says so with the bound it does meet and why.
 // The last test quantises the joint angles as a real arm's encoders do, and calibrates on a free
 // run first (docs/mujoco.md "Encoder quantisation").
 // In all: 10 contact episodes (the cases' minimum counts: 3, 2, 3, 2) on
 // links 4, 5, 6 and 7 of each robot.
 #include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
 
 #include <algorithm>
 #include <cmath>
@@ -30,6 +35,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -44,6 +50,7 @@
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/log.hpp"
 #include "extwrench/io/scenario_config.hpp"
+#include "extwrench/sim/controller.hpp"
 #include "support/scratch_dir.hpp"
 #include "support/text_files.hpp"
 
@@ -296,6 +303,16 @@ schemes:
        ":6: obstacles[0].solimp: expected [dmin, dmax, width, midpoint, power]"},
       {replaced(good, "engine: mujoco", "engine: mujoco\nlocked_joints: {joint7: 0}"),
        ":3: locked_joints: not with engine: mujoco"},
+      {replaced(good, "engine: mujoco", "engine: mujoco\nmujoco_option: {cone: conical}"),
+       ":3: mujoco_option.cone: expected one of pyramidal, elliptic, got 'conical'"},
+      {replaced(good, "engine: mujoco", "engine: mujoco\nmujoco_option: {impratio: 0}"),
+       ":3: mujoco_option.impratio"},
+      {replaced(good, "engine: mujoco", "engine: mujoco\nmujoco_option: {noslip_iterations: 3}"),
+       ":3: mujoco_option.noslip_iterations: unknown key"},
+      {replaced(good, "engine: mujoco", "engine: mujoco\nmujoco_option: elliptic"),
+       ":3: mujoco_option: expected a mapping"},
+      {replaced(good, "engine: mujoco", "engine: rigid\nmujoco_option: {cone: elliptic}"),
+       ":3: mujoco_option: an option of MuJoCo's: set 'engine: mujoco'"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const fs::path path = dir_ / ("bad" + std::to_string(i) + ".yaml");
@@ -320,6 +337,46 @@ schemes:
     EXPECT_NE(std::string(e.what()).find("needs an MJCF robot"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("urdf.yaml"), std::string::npos) << e.what();
   }
+}
+
+// `mujoco_option` reaches the model MuJoCo simulates, over the robot file's <option> (whose other
+// attributes stay), and without it the file's own values (here MuJoCo's defaults) are kept.
+TEST_F(MujocoCollisions, MujocoOptionSetsTheFrictionConeOverTheRobotFile) {
+  const std::string text = "robot: " EXTWRENCH_SOURCE_DIR
+                           "/models/paper_arm.xml"
+                           R"(
+engine: mujoco
+duration: 0.01
+trajectory: {offset: 0.3}
+obstacles:
+  - {name: post, type: box, size: [0.1, 0.1, 0.2], pose: {xyz: [1, 0, 0]}}
+schemes:
+  ft: {sensor: {type: ft}}
+)";
+  const auto simulator_of = [&](const std::string& yaml, const char* name) {
+    test::write_text(dir_ / name, yaml);
+    const Scenario s = load_scenario(dir_ / name);
+    return std::make_unique<mujoco::MujocoSimulator>(
+        s, sim::ComputedTorqueController(s.robot.model, s.trajectory, s.gains), s.simulation);
+  };
+  const auto file = simulator_of(text, "file.yaml");
+  EXPECT_EQ(file->mj_model()->opt.cone, mjCONE_PYRAMIDAL);
+  EXPECT_EQ(file->mj_model()->opt.impratio, 1.0);
+  EXPECT_EQ(file->mj_model()->opt.integrator, mjINT_IMPLICIT);  // paper_arm.xml's <option>
+  const auto set =
+      simulator_of(replaced(text, "engine: mujoco",
+                            "engine: mujoco\nmujoco_option: {cone: elliptic, impratio: 4}"),
+                   "set.yaml");
+  EXPECT_EQ(set->mj_model()->opt.cone, mjCONE_ELLIPTIC);
+  EXPECT_EQ(set->mj_model()->opt.impratio, 4.0);
+  EXPECT_EQ(set->mj_model()->opt.integrator, mjINT_IMPLICIT);
+  EXPECT_NE(set->scene().find("cone=\"elliptic\""), std::string::npos);
+  const auto back = simulator_of(
+      replaced(text, "engine: mujoco", "engine: mujoco\nmujoco_option: {cone: pyramidal}"),
+      "back.yaml");
+  EXPECT_EQ(back->mj_model()->opt.cone, mjCONE_PYRAMIDAL);
+  Sample sample;
+  EXPECT_TRUE(set->next(sample));  // and it runs
 }
 
 // The paper's scenario (scenarios/paper.yaml, a prescribed 20 N on link6) on the MuJoCo engine
@@ -367,15 +424,9 @@ TEST_F(MujocoCollisions, PaperArmSwingsIntoTwoBoxes) {
        kData / "paper_arm_boxes.yaml",
        false,
        3,
-       {{"ft", "link7", "force_error", 0.13,
-         "13.6 N RMS on the post's top edge, where MuJoCo's contact chatters: 23 of the 461 "
-         "samples have no contact, the force jumps 4.4 N RMS from one sample to the next. The "
-         "truth low-passed at K = 100 s^-1 is itself 9.1 % off it (7 % at 1000 s^-1); 11.5 % "
-         "measured, and more with a higher gain (12.6 % at K = 200, 14.1 % at 300)"},
-        {"ft", "link7", "line", 0.008, "the same chatter moves the line: 6.9 mm measured"},
-        {"none", "link5", "right_link", 0.0,
+       {{"none", "link5", "right_link", 0.0,
          "the shelf's force on link5 passes through joint 5's axis (along the forearm): joints "
-         "5-7 feel nothing and the residual names link4; 0 % measured (ft: 99.0 %)"}}});
+         "5-7 feel nothing and the residual names link4; 0 % measured (ft: 98.5 %)"}}});
 }
 
 TEST_F(MujocoCollisions, PaperArmHitByAMovingCapsule) {
@@ -388,7 +439,7 @@ TEST_F(MujocoCollisions, PandaSwingsIntoTwoBoxes) {
        true,
        3,
        {{"none", "link5", "right_link", 0.0,
-         "joints 6-7 feel nothing of the shelf's force on link5: 0 % measured (ft: 99.0 %)"}}});
+         "joints 6-7 feel nothing of the shelf's force on link5: 0 % measured (ft: 97.8 %)"}}});
 }
 
 TEST_F(MujocoCollisions, PandaHitByAMovingCapsule) {
@@ -396,10 +447,12 @@ TEST_F(MujocoCollisions, PandaHitByAMovingCapsule) {
        kData / "panda_person.yaml",
        true,
        2,
-       {{"ft", "link4", "force_error", 0.07,
-         "a 75 ms impact (44 N RMS): most of its 26 samples lie in the residual's transient; "
-         "6.7 % measured"},
-        {"ft", "link4", "line", 0.019, "18.3 mm measured, the same transient"}}});
+       {{"ft", "link4", "force_error", 0.065,
+         "an 85 ms impact (65.5 N RMS) on a mesh's edge: most of its 36 samples lie in the "
+         "residual's transient; 5.9 % measured"},
+        {"ft", "link4", "line", 0.022,
+         "20.8 mm measured: the same transient, and the centre of pressure jumps between the "
+         "edge's contact points"}}});
 }
 
 // A real arm's joint angles are quantised: 2π/2^19 rad here (19-bit encoders), q̇ the backward

@@ -194,6 +194,16 @@ std::string scene_mjcf(const Scenario& s, const Pose& X_WS, const Pose& X_mj_roo
     }
     mujoco->InsertEndChild(contact);
   }
+  // mujoco_option: set on the file's <option> (a new one when it has none), over its own values.
+  const MujocoOption& option = s.mujoco_option;
+  if (option.cone || option.impratio) {
+    tinyxml2::XMLElement* opt = mujoco->FirstChildElement("option");
+    if (opt == nullptr) opt = mujoco->InsertFirstChild(doc.NewElement("option"))->ToElement();
+    if (option.cone)
+      opt->SetAttribute("cone",
+                        *option.cone == MujocoOption::Cone::kElliptic ? "elliptic" : "pyramidal");
+    if (option.impratio) opt->SetAttribute("impratio", numbers({*option.impratio}).c_str());
+  }
   tinyxml2::XMLElement* sensor = doc.NewElement("sensor");
   for (const auto& [type, name] :
        {std::pair{"force", kSceneForceSensor}, std::pair{"torque", kSceneTorqueSensor}}) {

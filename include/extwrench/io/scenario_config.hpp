@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,16 @@ struct Obstacle {
   [[nodiscard]] Vector3 position(double t) const;
 };
 
+/// `mujoco_option` (engine: mujoco): attributes of MuJoCo's <option> that the scene sets over
+/// the robot file's own (unset: the file's, or MuJoCo's defaults: a pyramidal cone, impratio 1).
+struct MujocoOption {
+  enum class Cone { kPyramidal, kElliptic };
+  /// The friction cone of every contact: MuJoCo's pyramid approximates the Coulomb cone with
+  /// four facets; the elliptic cone is the Coulomb cone itself.
+  std::optional<Cone> cone;
+  std::optional<double> impratio;  ///< friction-to-normal impedance ratio, > 0
+};
+
 struct Scenario;
 
 /// What runs `engine: mujoco` (extwrench::mujoco's register_mujoco_engine() installs it): the
@@ -91,6 +102,7 @@ struct Scenario {
   enum class Engine { kRigid, kMujoco };
   Engine engine = Engine::kRigid;
   std::vector<Obstacle> obstacles;
+  MujocoOption mujoco_option;
   sim::SinusoidalTrajectory trajectory;
   sim::PidGains gains;
   double controller_omega = 0.0;  ///< when the gains come from `controller.omega`
