@@ -18,9 +18,9 @@
 //   more than 50 ms after the last contact (0).
 //
 // The scenes use MuJoCo's elliptic friction cone (`mujoco_option: {cone: elliptic}`): with its
-// default pyramid, the paper arm's link7 sliding on the post's edge chattered (23 of 404 samples
-// without contact, the force jumping 4.6 N RMS from one sample to the next, against 5 and 1.0 N
-// with the Coulomb cone itself), a simulator artefact that no estimator follows.
+// default pyramid, the paper arm's link7 sliding on the post's edge chattered (23 of 411 samples
+// without contact, the force jumping 4.5 N RMS from one sample to the next, against 10 of 416 and
+// 1.0 N with the Coulomb cone itself), a simulator artefact that no estimator follows.
 // Where a figure is not met, the case below says so with the bound it does meet and why.
 // The last test quantises the joint angles as a real arm's encoders do, and calibrates on a free
 // run first (docs/mujoco.md "Encoder quantisation").
