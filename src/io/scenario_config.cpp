@@ -292,6 +292,10 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
       y.fail(kv.first, k, "scheme names become directory names: use letters, digits, '_' or '-'");
     }
     if (!kv.second.IsMap()) y.fail(kv.second, k, "expected an estimator configuration (a mapping)");
+    // The scheme's keys go one by one into its config.yaml: a key given twice would be two
+    // configurations in one (yaml-cpp keeps both; the estimator reads the first, the copy the
+    // last).
+    y.unique_keys(kv.second, k);
     if (kv.second["robot"]) {
       y.fail(kv.second["robot"], k + ".robot",
              "schemes use the scenario's perturbed model; remove 'robot'");
@@ -538,13 +542,21 @@ std::string pose_yaml(const Pose& X) {
 }  // namespace
 
 std::string scheme_config_yaml(const Scenario& s, const SchemeSpec& scheme) {
-  YAML::Node node = YAML::Load(scheme.yaml);
+  const std::string label = s.source.string() + ": scheme '" + scheme.name + "'";
+  YAML::Node node;
+  try {
+    node = YAML::Load(scheme.yaml);
+  } catch (const YAML::Exception& e) {
+    throw Error(label + ": not YAML: " + e.what());
+  }
+  if (!node.IsMap()) throw Error(label + ": expected an estimator configuration (a mapping)");
   YAML::Node out(YAML::NodeType::Map);
   out["robot"] = "../model_estimator.urdf";
   const Vector3& g = s.robot.model.gravity;
   out["gravity"] = YAML::Load("[" + format_number(g.x()) + ", " + format_number(g.y()) + ", " +
                               format_number(g.z()) + "]");
   for (const auto& kv : node) out[kv.first.Scalar()] = kv.second;
+  if (!out["sensor"].IsMap()) throw Error(label + ": sensor: expected a mapping (type: ...)");
   if (out["sensor"]["type"].Scalar() != "none" && !out["sensor"]["pose"]) {
     out["sensor"]["pose"] = YAML::Load(pose_yaml(s.simulation.sensor.X_WS));
   }

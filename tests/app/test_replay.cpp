@@ -327,6 +327,11 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        "schemes.ft.robot: schemes use the scenario's perturbed model"},
       {"scheme_without_sensor", replace(kGoodScenario, "ft: {sensor: {type: ft}, ", "ft: {"),
        "schemes.ft.sensor.type: missing"},
+      // yaml-cpp keeps both; the scheme's config.yaml would have taken the second (found by
+      // fuzz_scenario: a scalar second `sensor` then threw from yaml-cpp, uncaught).
+      {"scheme_key_twice",
+       replace(kGoodScenario, "ft: {sensor: {type: ft}, ", "ft: {sensor: {type: ft}, sensor: ft, "),
+       ":8: schemes.ft.sensor: given twice in one mapping (first at "},
       {"no_schemes", kGoodScenario.substr(0, kGoodScenario.find("schemes:")), "schemes: missing"},
       {"yaml_syntax", kGoodScenario + "forces: [\n", "YAML syntax error"},
       {"substeps", kGoodScenario + "substeps: 2.5\n",

@@ -5,7 +5,6 @@
 #include <fstream>
 #include <limits>
 #include <map>
-#include <set>
 #include <sstream>
 
 #include "extwrench/core/error.hpp"
@@ -82,8 +81,21 @@ void YamlReader::fail(const YAML::Node& node, const std::string& key,
 
 void YamlReader::only_keys(const YAML::Node& map, const std::string& context,
                            std::initializer_list<const char*> allowed) const {
+  keys_of(map, context, [&](const YAML::Node& key_node, const std::string& k) {
+    if (std::find_if(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }) ==
+        allowed.end())
+      fail(key_node, key(context, k), "unknown key (expected one of: " + listed(allowed) + ")");
+  });
+}
+
+void YamlReader::unique_keys(const YAML::Node& map, const std::string& context) const {
+  keys_of(map, context, [](const YAML::Node&, const std::string&) {});
+}
+
+void YamlReader::keys_of(
+    const YAML::Node& map, const std::string& context,
+    const std::function<void(const YAML::Node&, const std::string&)>& check) const {
   if (!map.IsMap()) fail(map, context.empty() ? "(top level)" : context, "expected a mapping");
-  const std::set<std::string> ok(allowed.begin(), allowed.end());
   // YAML forbids a key twice in one mapping; yaml-cpp keeps both and map[k] reads the first, so
   // a second `detection:` appended to a file would be ignored without a word.
   std::map<std::string, YAML::Node> seen;
@@ -95,8 +107,7 @@ void YamlReader::only_keys(const YAML::Node& map, const std::string& context,
                                                                                   : "null"));
     }
     const std::string k = kv.first.Scalar();
-    if (ok.count(k) == 0)
-      fail(kv.first, key(context, k), "unknown key (expected one of: " + listed(allowed) + ")");
+    check(kv.first, k);
     const auto [first, inserted] = seen.emplace(k, kv.first);
     if (!inserted) {
       fail(kv.first, key(context, k),

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <ios>
 #include <string>
@@ -75,6 +76,9 @@ class YamlReader {
   /// the mapping ("" at the top level), and prefixes the unknown key in the message.
   void only_keys(const YAML::Node& map, const std::string& context,
                  std::initializer_list<const char*> allowed) const;
+  /// Throws unless `map` is a mapping whose keys are names, each given once (any names: a
+  /// mapping whose keys another reader checks, e.g. a scenario's scheme).
+  void unique_keys(const YAML::Node& map, const std::string& context) const;
   /// map[k], or "context.k: missing (required)".
   [[nodiscard]] YAML::Node required(const YAML::Node& map, const std::string& context,
                                     const char* k) const;
@@ -127,6 +131,10 @@ class YamlReader {
   [[nodiscard]] int body(const Model& model, const YAML::Node& node, const std::string& key) const;
 
  private:
+  /// The checks of only_keys and unique_keys: a mapping, name keys, each once; `check` sees each
+  /// key first (only_keys: whether it is allowed).
+  void keys_of(const YAML::Node& map, const std::string& context,
+               const std::function<void(const YAML::Node&, const std::string&)>& check) const;
   [[nodiscard]] double parsed(const YAML::Node& node, const std::string& key,
                               NumberRules rules) const;
 
