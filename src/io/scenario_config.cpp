@@ -216,8 +216,16 @@ void parse_seeds(const YamlReader& y, const YAML::Node& root, Scenario& s) {
     return;
   }
   if (sd.size() == 0) y.fail(sd, k, "expected at least one seed");
-  for (std::size_t i = 0; i < sd.size(); ++i)
-    s.seeds.push_back(static_cast<std::uint64_t>(y.integer(sd[i], YamlReader::item(k, i), seed)));
+  for (std::size_t i = 0; i < sd.size(); ++i) {
+    const auto value = static_cast<std::uint64_t>(y.integer(sd[i], YamlReader::item(k, i), seed));
+    // Each seed's run writes DIR/seed_<n>/: the same seed twice would write one directory twice.
+    for (std::size_t j = 0; j < i; ++j) {
+      if (s.seeds[j] == value)
+        y.fail(sd[i], YamlReader::item(k, i),
+               std::to_string(value) + " twice (also " + YamlReader::item(k, j) + ")");
+    }
+    s.seeds.push_back(value);
+  }
 }
 
 // duration, sample_time, substeps and model_error.
@@ -285,6 +293,7 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
   if (!schemes) y.fail(root, "schemes", "missing (one or more estimator configurations, by name)");
   if (!schemes.IsMap() || schemes.size() == 0)
     y.fail(schemes, "schemes", "expected a mapping name -> estimator configuration");
+  y.unique_keys(schemes, "schemes");  // each scheme writes DIR/<name>/
   for (const auto& kv : schemes) {
     const std::string name = kv.first.Scalar();
     const std::string k = "schemes." + name;

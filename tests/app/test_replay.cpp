@@ -329,6 +329,12 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        "schemes.ft.sensor.type: missing"},
       // yaml-cpp keeps both; the scheme's config.yaml would have taken the second (found by
       // fuzz_scenario: a scalar second `sensor` then threw from yaml-cpp, uncaught).
+      {"scheme_twice",
+       replace(kGoodScenario, "contact: {model: pure_force}}",
+               "contact: {model: pure_force}}\n  ft: {sensor: {type: none}}"),
+       ":9: schemes.ft: given twice in one mapping (first at "},
+      {"seed_twice", replace(kGoodScenario, "seeds: [1]", "seeds: [1, 2, 1]"),
+       ":2: seeds[2]: 1 twice (also seeds[0])"},
       {"scheme_key_twice",
        replace(kGoodScenario, "ft: {sensor: {type: ft}, ", "ft: {sensor: {type: ft}, sensor: ft, "),
        ":8: schemes.ft.sensor: given twice in one mapping (first at "},
