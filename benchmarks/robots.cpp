@@ -1,7 +1,5 @@
 #include "robots.hpp"
 
-#include <tinyxml2.h>
-
 #include <cmath>
 #include <filesystem>
 #include <kdl/chainidsolver_recursive_newton_euler.hpp>
@@ -9,7 +7,6 @@
 #include <kdl_parser/kdl_parser.hpp>
 #include <memory>
 #include <random>
-#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +15,7 @@
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/model/sample_models.hpp"
+#include "reference/reference_util.hpp"
 #include "support/paper_arm_table.hpp"
 
 namespace extwrench::bench {
@@ -26,35 +24,6 @@ namespace {
 // The paper's table as the tests write it, for KDL's chain: an independent copy of the numbers
 // that the library's paper_arm() is built from.
 using namespace test::paper_arm_table;
-
-// The URDF as KDL gets it: the file without its <collision> elements and without the root link's
-// <inertial>. Neither enters KDL's dynamics, and urdfdom would print an [ERROR] for every capsule
-// (a geometry it does not know) and a [WARN] for the root's inertia (which KDL ignores) on each
-// `make bench`. The joints, placements and the moving links' inertias reach kdl_parser as written.
-std::string urdf_for_kdl(const std::filesystem::path& file) {
-  tinyxml2::XMLDocument doc;
-  if (doc.LoadFile(file.string().c_str()) != tinyxml2::XML_SUCCESS) {
-    throw std::runtime_error(file.string() + ": " + doc.ErrorStr());
-  }
-  tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
-  if (robot == nullptr) throw std::runtime_error(file.string() + ": no <robot> element");
-  std::set<std::string> children;
-  for (auto* j = robot->FirstChildElement("joint"); j; j = j->NextSiblingElement("joint")) {
-    const auto* child = j->FirstChildElement("child");
-    if (child != nullptr && child->Attribute("link") != nullptr)
-      children.insert(child->Attribute("link"));
-  }
-  for (auto* l = robot->FirstChildElement("link"); l; l = l->NextSiblingElement("link")) {
-    while (auto* c = l->FirstChildElement("collision")) l->DeleteChild(c);
-    const char* name = l->Attribute("name");
-    if (name != nullptr && children.count(name) == 0) {
-      if (auto* inertial = l->FirstChildElement("inertial")) l->DeleteChild(inertial);
-    }
-  }
-  tinyxml2::XMLPrinter printer;
-  doc.Print(&printer);
-  return printer.CStr();
-}
 
 KDL::Chain paper_arm_chain_from_dh() {
   KDL::Chain chain;
@@ -118,7 +87,12 @@ PaperArm load_paper_arm() {
     arm.model = std::move(robot.model);
     arm.geometry = std::move(robot.geometry);
     KDL::Tree tree;
-    if (!kdl_parser::treeFromString(urdf_for_kdl(urdf), tree)) {
+    // KDL's copy without the geometry and the root's inertia, which it does not use: urdfdom would
+    // print an [ERROR] for every capsule and a [WARN] for the root's inertia at each `make bench`.
+    test::UrdfEditOptions kdl_edit;
+    kdl_edit.drop_root_inertial = true;
+    if (!kdl_parser::treeFromString(
+            test::urdf_for_reference(test::read_text(urdf.string()), kdl_edit), tree)) {
       throw std::runtime_error("kdl_parser could not read " + urdf.string());
     }
     // Tip: the deepest URDF link welded to the last body (a flange frame if there is one),

@@ -16,9 +16,10 @@
 namespace extwrench::bench {
 
 /// The paper's 7R arm (Table II) for both libraries: from models/paper_arm.urdf (our loader and
-/// kdl_parser::treeFromString on the file without its collision shapes) when the file exists,
-/// otherwise built in code from the DH table (our Model by hand, KDL's chain with KDL::Frame::DH).
-/// Either way, set-up checks that KDL's RNE and ours agree on the seeded states (throws otherwise).
+/// kdl_parser::treeFromString on test::urdf_for_reference's copy: no geometry, no root inertia)
+/// when the file exists, otherwise built in code from the DH table (our Model by hand, KDL's chain
+/// with KDL::Frame::DH). Either way, set-up checks that KDL's RNE and ours agree on the seeded
+/// states (throws otherwise).
 struct PaperArm {
   Model model;
   GeometryModel geometry;  ///< collision shapes (capsules); see paper_arm()

@@ -31,11 +31,14 @@ struct UrdfEditOptions {
   std::string new_root;
   /// Elements inserted as the last children of <robot> (e.g. a <mujoco> compiler block).
   std::string extra_xml;
+  /// Remove the root link's <inertial>: kdl_parser ignores it anyway and warns about it, where
+  /// the joint-space quantities compared do not depend on it.
+  bool drop_root_inertial = false;
 };
 
 /// The same robot for a reference parser: <visual> and <collision> removed (urdfdom rejects our
 /// <capsule> extension and the references need no geometry), optionally truncated and re-rooted.
-/// The mass properties, joints and frames are untouched.
+/// The mass properties (but the root's with drop_root_inertial), joints and frames are untouched.
 inline std::string urdf_for_reference(const std::string& xml, const UrdfEditOptions& opt) {
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.c_str()) != tinyxml2::XML_SUCCESS) throw std::runtime_error("bad XML");
@@ -75,6 +78,9 @@ inline std::string urdf_for_reference(const std::string& xml, const UrdfEditOpti
         if (gtag == "visual" || gtag == "collision") geometry.push_back(g);
       }
       for (auto* g : geometry) e->DeleteChild(g);
+      if (opt.drop_root_inertial && root == e->Attribute("name")) {
+        if (auto* inertial = e->FirstChildElement("inertial")) e->DeleteChild(inertial);
+      }
     } else if (tag == "joint") {
       if (!keep.count(e->FirstChildElement("child")->Attribute("link"))) remove.push_back(e);
     } else if (tag == "transmission" || tag == "gazebo" || tag == "mujoco") {
