@@ -377,6 +377,30 @@ schemes:
   EXPECT_EQ(back->mj_model()->opt.cone, mjCONE_PYRAMIDAL);
   Sample sample;
   EXPECT_TRUE(set->next(sample));  // and it runs
+  // The robot's <option> in an <include>d file, which the file's own text does not show: the
+  // scenario's still wins (it once went first in the text and the included one overrode it,
+  // silently), and the included integrator stays.
+  const std::string arm = test::read_text(EXTWRENCH_SOURCE_DIR "/models/paper_arm.xml");
+  test::write_text(dir_ / "paper_arm_included_option.xml",
+                   replaced(arm, R"(<option timestep="0.001" integrator="implicit"/>)",
+                            R"(<include file="arm_option.xml"/>)"));
+  test::write_text(
+      dir_ / "arm_option.xml",
+      R"(<mujoco><option integrator="implicit" cone="pyramidal" impratio="2"/></mujoco>)");
+  const std::string included =
+      replaced(replaced(text, EXTWRENCH_SOURCE_DIR "/models/paper_arm.xml",
+                        (dir_ / "paper_arm_included_option.xml").string()),
+               "engine: mujoco", "engine: mujoco\nmujoco_option: {cone: elliptic, impratio: 4}");
+  const auto through_include = simulator_of(included, "included.yaml");
+  EXPECT_EQ(through_include->mj_model()->opt.cone, mjCONE_ELLIPTIC);
+  EXPECT_EQ(through_include->mj_model()->opt.impratio, 4.0);
+  EXPECT_EQ(through_include->mj_model()->opt.integrator, mjINT_IMPLICIT);
+  const auto included_only =
+      simulator_of(replaced(text, EXTWRENCH_SOURCE_DIR "/models/paper_arm.xml",
+                            (dir_ / "paper_arm_included_option.xml").string()),
+                   "included_only.yaml");
+  EXPECT_EQ(included_only->mj_model()->opt.cone, mjCONE_PYRAMIDAL);  // the file's, unset here
+  EXPECT_EQ(included_only->mj_model()->opt.impratio, 2.0);
 }
 
 // The paper's scenario (scenarios/paper.yaml, a prescribed 20 N on link6) on the MuJoCo engine

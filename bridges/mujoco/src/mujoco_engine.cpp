@@ -85,6 +85,20 @@ mjModel* compile(const std::string& xml, const std::filesystem::path& robot_path
   return m;
 }
 
+// The compiled model has the options the scenario asked for (no later <option> overrode them).
+void check_option(const mjModel* m, const MujocoOption& option, const std::string& label) {
+  const auto fail = [&](const std::string& what) {
+    throw Error(label + ": mujoco_option." + what +
+                " did not reach the compiled model (an <option> MuJoCo read after it?)");
+  };
+  if (option.cone) {
+    const int cone =
+        *option.cone == MujocoOption::Cone::kElliptic ? mjCONE_ELLIPTIC : mjCONE_PYRAMIDAL;
+    if (m->opt.cone != cone) fail("cone");
+  }
+  if (option.impratio && m->opt.impratio != *option.impratio) fail("impratio");
+}
+
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }
 };
@@ -194,15 +208,18 @@ std::string scene_mjcf(const Scenario& s, const Pose& X_WS, const Pose& X_mj_roo
     }
     mujoco->InsertEndChild(contact);
   }
-  // mujoco_option: set on the file's <option> (a new one when it has none), over its own values.
+  // mujoco_option: an <option> of its own, last in the file, carrying only the attributes set.
+  // MuJoCo merges every <option> attribute by attribute, the last one winning: the file's other
+  // values stay, and an <option> in an <include>d file (which the file's own text does not show)
+  // cannot override it, as it did when this edited the first <option> of the text.
   const MujocoOption& option = s.mujoco_option;
   if (option.cone || option.impratio) {
-    tinyxml2::XMLElement* opt = mujoco->FirstChildElement("option");
-    if (opt == nullptr) opt = mujoco->InsertFirstChild(doc.NewElement("option"))->ToElement();
+    tinyxml2::XMLElement* opt = doc.NewElement("option");
     if (option.cone)
       opt->SetAttribute("cone",
                         *option.cone == MujocoOption::Cone::kElliptic ? "elliptic" : "pyramidal");
     if (option.impratio) opt->SetAttribute("impratio", numbers({*option.impratio}).c_str());
+    mujoco->InsertEndChild(opt);
   }
   tinyxml2::XMLElement* sensor = doc.NewElement("sensor");
   for (const auto& [type, name] :
@@ -247,6 +264,7 @@ MujocoSimulator::MujocoSimulator(const Scenario& s, sim::ComputedTorqueControlle
   }
   scene_ = scene_mjcf(s, config_.sensor.X_WS, X_mj_root_, robot_bodies);
   m_ = compile(scene_, s.robot_path, label);
+  check_option(m_, s.mujoco_option, label);
   m_->opt.timestep = config_.sample_time / config_.substeps;
   d_ = mj_makeData(m_);
   BridgeOptions bridge_options;

@@ -28,7 +28,8 @@ inline constexpr const char* kSceneObstaclePrefix = "extwrench_obstacle_";
 /// <torque> sensors at the base sensor's pose `X_WS` on the root body, and the obstacles
 /// (geoms `extwrench_obstacle_NAME`, in mocap bodies of that name when they move), and a contact
 /// <exclude> for every pair of `robot_bodies` (no self-collisions), and the scenario's
-/// `mujoco_option` on the file's <option> (a new one when it has none). `X_mj_root` is the root
+/// `mujoco_option` in an <option> of its own, last (MuJoCo merges <option>s attribute by
+/// attribute, the last one winning, so the file's other values stay). `X_mj_root` is the root
 /// body's pose in MuJoCo's world (the obstacles are given in W, the root's frame).
 /// Throws extwrench::Error naming the robot file when it is not MJCF or its root body is not
 /// found in its text.
