@@ -62,8 +62,13 @@ class UrdfParser {
                   "load_robot in a program linked with extwrench::mujoco (the extwrench CLI is)");
     }
     if (robot == nullptr || std::strcmp(robot->Name(), "robot") != 0) {
+      // MuJoCo ignores the root's name in an <include>d file (the Menagerie-style <panda> of a
+      // robot split over files), so a user may give us that part.
       throw Error(file_ + ":" + std::to_string(robot ? robot->GetLineNum() : 1) +
-                  ": the root element must be <robot>, got <" + (robot ? robot->Name() : "") + ">");
+                  ": the root element must be <robot> (URDF) or <mujoco> (MJCF), got <" +
+                  (robot ? robot->Name() : "") +
+                  ">: if this is part of an MJCF model, which another file <include>s, load that "
+                  "file");
     }
     ModelBuilder builder;
     if (const char* name = robot->Attribute("name")) builder.set_name(name);

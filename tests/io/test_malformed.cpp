@@ -80,7 +80,8 @@ const std::map<std::string, Expected>& cases() {
        {14, {"<mesh> of link 'arm'", "attribute 'filename'", "does_not_exist.stl", "not found"}}},
       {"link_missing_name.urdf", {8, {"<link>", "attribute 'name': missing"}}},
       {"not_well_formed.urdf", {2, {"not well-formed XML"}}},
-      {"root_not_robot.urdf", {2, {"the root element must be <robot>, got <model>"}}},
+      {"root_not_robot.urdf",
+       {2, {"the root element must be <robot> (URDF) or <mujoco> (MJCF), got <model>"}}},
       {"massless_leaf.urdf",
        {11, {"joint 'j1'", "link 'arm'", "mass matrix is not positive definite"}}},
       // ---- MJCF in a program without extwrench::mujoco (tests/reference reads it)
