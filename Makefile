@@ -8,7 +8,7 @@ RELEASE_BUILD ?= build-install
 PREFIX ?= /usr/local
 FUZZ_BUILD ?= build-fuzz
 FUZZ_SECONDS ?= 600
-FUZZ_HARNESSES ?= urdf dh_yaml estimator_config scenario csv_log estimator mjcf
+FUZZ_HARNESSES ?= urdf dh_yaml estimator_config scenario csv_log estimator calibration_file mjcf
 
 .PHONY: all build test test-sanitize fuzz-build fuzz demo bench install format clean
 

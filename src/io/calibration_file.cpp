@@ -207,8 +207,16 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
   }
   double worst = 0.0;
   for (const JointFitReport& j : c.joints) worst = std::max(worst, j.condition);
-  y << "fit:\n  samples: " << c.samples_used << "\n  condition: " << worst << "\n  joints:\n"
-    << joint_table(c);
+  y << "fit:\n  samples: " << c.samples_used << "\n  condition: " << worst << '\n';
+  if (!c.joints.empty()) {
+    y << "  joints:\n" << joint_table(c);
+  } else if (c.residual_noise.size() > 0) {
+    // A calibration read from a file keeps only the report's noise levels: written back, they
+    // are what a configuration including the file takes (load_calibration).
+    y << "  joints:\n";
+    for (Eigen::Index i = 0; i < c.residual_noise.size(); ++i)
+      y << "    - {joint: " << i + 1 << ", noise_std: " << c.residual_noise[i] << "}\n";
+  }
   y << "  suspect_windows: [";
   for (std::size_t i = 0; i < c.suspect_windows.size(); ++i) {
     const SuspectWindow& w = c.suspect_windows[i];
@@ -232,7 +240,11 @@ Calibration load_calibration(const std::filesystem::path& path, int n) {
                  {"calibration", "observer", "friction", "detection", "sensor", "payload",
                   "model_check", "fit", "holdout", "warnings"});
     Calibration c;
-    c.source = path.string();
+    // The log it came from, as `calibrate` wrote it (the rest of that header is a report).
+    const YAML::Node header = root["calibration"];
+    c.source = header && header.IsMap() && header["source"] && header["source"].IsScalar()
+                   ? header["source"].Scalar()
+                   : path.string();
     const io_detail::Range positive = io_detail::positive();
     const io_detail::Range non_negative = io_detail::non_negative(">= 0 [N]");
     const YAML::Node ob = rd.required(root, "", "observer");

@@ -361,6 +361,31 @@ TEST(CalibrationFile, IncludedByAConfigurationGivesTheSameOptions) {
   }
 }
 
+// A calibration read back and written again (a user's script that edits one value, say) is a
+// file the loader accepts, with what a configuration takes from it: the friction, thresholds and
+// the residual's noise levels (fit.joints[].noise_std). The written form is a fixed point from
+// the first read on. It once wrote an empty fit.joints, which the loader refuses.
+TEST(CalibrationFile, ReadBackAndWrittenAgainLoadsTheSame) {
+  const Model model = paper_arm();
+  Calibration cal = calibrate(model, no_sensor(), free_log(8.0));
+  cal.source = "free.csv";
+  const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_written_again";
+  fs::create_directories(dir);
+  std::ofstream(dir / "first.yaml") << calibration_to_yaml(cal, nullptr);
+  const Calibration read = load_calibration(dir / "first.yaml", 7);
+  EXPECT_EQ(read.source, "free.csv");
+  ASSERT_EQ(read.residual_noise.size(), 7);
+  EXPECT_TRUE(read.residual_noise.isApprox(cal.residual_noise, 1e-5));  // the report's 6 digits
+  const std::string second = calibration_to_yaml(read, nullptr);
+  std::ofstream(dir / "second.yaml") << second;
+  const Calibration again = load_calibration(dir / "second.yaml", 7);
+  EXPECT_EQ(again.residual_noise, read.residual_noise);
+  EXPECT_EQ(again.tau_threshold, read.tau_threshold);
+  EXPECT_EQ(again.friction.coulomb, read.friction.coulomb);
+  EXPECT_EQ(again.source, "free.csv");
+  EXPECT_EQ(calibration_to_yaml(again, nullptr), second);
+}
+
 TEST(CalibratedEstimator, UpdateAllocatesNothing) {
   if (!test::allocation_counting_available()) GTEST_SKIP() << "sanitizer build";
   const Model model = paper_arm();

@@ -162,7 +162,8 @@ struct Calibration {
   std::vector<JointFitReport> joints;
   int samples_used = 0;
   double t_begin = 0.0, t_end = 0.0;  ///< time span of the samples given [s]
-  std::string source;                 ///< the log it came from (set by the caller)
+  std::string source;                 ///< the log it came from (set by the caller;
+                                      ///< load_calibration: the file's calibration.source)
   std::vector<SuspectWindow> suspect_windows;
   std::vector<std::string> warnings;
 };
