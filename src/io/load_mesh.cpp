@@ -53,6 +53,19 @@ std::shared_ptr<const TriangleMesh> make_triangle_mesh(
     throw Error(name + ": triangle vertex index out of range [0, " +
                 std::to_string(vertices.cols()) + ")");
   }
+  // Some degenerate triangles are harmless; a mesh of nothing else has no surface for a line of
+  // action to enter (a broken export), and every isolation on its link would miss silently.
+  bool has_area = false;
+  for (Eigen::Index t = 0; t < triangles.cols() && !has_area; ++t) {
+    const Vector3 a = vertices.col(triangles(0, t));
+    has_area =
+        (vertices.col(triangles(1, t)) - a).cross(vertices.col(triangles(2, t)) - a).squaredNorm() >
+        0.0;
+  }
+  if (!has_area) {
+    throw Error(name + ": mesh has no surface: all " + std::to_string(triangles.cols()) +
+                " triangles are degenerate (zero area)");
+  }
   auto mesh = std::make_shared<TriangleMesh>();
   mesh->path = name;
   mesh->ray_caster = make_embree_ray_caster(vertices, triangles, name);

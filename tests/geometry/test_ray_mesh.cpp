@@ -269,6 +269,20 @@ TEST(RayMesh, LoadingErrorsNameTheFile) {
   EXPECT_THROW(
       (void)make_triangle_mesh(Matrix3X::Zero(3, 3), Eigen::Matrix<int, 3, 1>(0, 1, 3), "bad"),
       Error);
+  // Only degenerate triangles (collinear points, a repeated vertex): no surface to hit.
+  const test::TempFile flat("degenerate_only.obj");
+  {
+    std::ofstream out(flat.path());
+    out << "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 3\nf 1 4 1\n";
+  }
+  try {
+    (void)load_mesh(flat.path());
+    FAIL() << "expected an Error";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(flat.path().string()), std::string::npos) << what;
+    EXPECT_NE(what.find("all 2 triangles are degenerate"), std::string::npos) << what;
+  }
 }
 
 std::vector<std::filesystem::path> panda_meshes() {
