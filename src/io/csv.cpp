@@ -248,7 +248,18 @@ std::optional<int> CsvReader::find_column(std::string_view column_name) const {
 
 int CsvReader::column(std::string_view column_name) const {
   if (const auto c = find_column(column_name)) return *c;
-  throw Error(name_ + ":1: missing column '" + std::string(column_name) + "'");
+  throw Error(name_ + ":1: missing column '" + std::string(column_name) + "'" + separator_hint());
+}
+
+std::string CsvReader::separator_hint() const {
+  if (header_.size() != 1) return {};
+  const std::string& only = header_.front();
+  const char* separator = only.find(';') != std::string::npos    ? "';'"
+                          : only.find('\t') != std::string::npos ? "a tab"
+                                                                 : nullptr;
+  if (separator == nullptr) return {};
+  return std::string("; the header is a single column whose name holds ") + separator +
+         ": the separator must be ',' (docs/cli.md#csv-files-all-commands)";
 }
 
 bool CsvReader::next_row() {

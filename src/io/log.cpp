@@ -54,7 +54,7 @@ LogReader::LogReader(const std::filesystem::path& path, const Model& model)
       throw Error(csv_.name() + ":1: missing column '" + name + "' (robot '" + model.name +
                   "' has " + std::to_string(n) + " joints: the log needs t, q1..q" +
                   std::to_string(n) + ", tau1..tau" + std::to_string(n) +
-                  "; see docs/log_format.md)");
+                  "; see docs/log_format.md)" + csv_.separator_hint());
     }
     known.insert(*c);
     return *c;

@@ -74,6 +74,23 @@ TEST(CsvReader, NamesTheFileInTheMissingColumnError) {
   EXPECT_EQ(error_of([&] { (void)reader.column("dq1"); }), "log.csv:1: missing column 'dq1'");
 }
 
+// A spreadsheet saved in a locale whose list separator is ';' (or as tab-separated text) gives a
+// header of one column: the error says why every column seems missing.
+TEST(CsvReader, AHeaderOfOneColumnHoldingSemicolonsOrTabsNamesTheSeparator) {
+  for (const auto& [text, separator] :
+       {std::pair{"t;q1;q2\n0;1;2\n", "';'"}, std::pair{"t\tq1\tq2\n0\t1\t2\n", "a tab"}}) {
+    std::istringstream in(text);
+    CsvReader reader(in, "log.csv");
+    EXPECT_EQ(error_of([&] { (void)reader.column("q1"); }),
+              std::string("log.csv:1: missing column 'q1'; the header is a single column whose "
+                          "name holds ") +
+                  separator + ": the separator must be ',' (docs/cli.md#csv-files-all-commands)");
+  }
+  std::istringstream plain("t\n0\n");  // one column, nothing odd in it: no hint
+  EXPECT_EQ(error_of([&] { (void)CsvReader(plain, "log.csv").column("q1"); }),
+            "log.csv:1: missing column 'q1'");
+}
+
 TEST(CsvReader, AcceptsCrlfBlankLinesByteOrderMarkAndNoFinalNewline) {
   std::istringstream in("\xEF\xBB\xBFt , x\r\n\r\n1, 2\r\n   \n\t\n3,4");
   CsvReader reader(in, "crlf.csv");

@@ -60,6 +60,10 @@ class CsvReader {
   [[nodiscard]] std::optional<int> find_column(std::string_view column_name) const;
   /// Index of the column of that name; throws "<file>:<line>: missing column '<name>'".
   [[nodiscard]] int column(std::string_view column_name) const;
+  /// For a missing-column message: when the header is a single column holding ';' or a tab
+  /// (a spreadsheet's export in a locale whose separator is not ','), a sentence saying so;
+  /// else empty.
+  [[nodiscard]] std::string separator_hint() const;
 
   /// Advances to the next non-empty row. Returns false at the end of the file. Throws if the
   /// row has the wrong number of cells or an unterminated quote.
