@@ -307,6 +307,7 @@ py::dict contact_summary_py(const Estimator& source, const py::handle& t, const 
   d["text"] = contact_summary(tally, model);
   d["note"] = frequent_alarms_note(tally);
   d["disagreement_warning"] = disagreement_warning(tally);
+  d["time_step_note"] = time_step_note(tally);
   return d;
 }
 

@@ -90,8 +90,9 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
     line_point_W, each (N, 3), world frame), status (str), cond, r1..rn (views of residual
     (N, n)); besides: flags (uint32 bits), point_L, line_direction_W (N, 3), surface_distance.
     With notes, what `extwrench estimate` notes on stderr is an EstimateWarning: contacts that
-    look like the model's error (when the configuration includes no calibration), or mostly
-    flagged 'disagreement'. contact_summary() gives the counts.
+    look like the model's error (when the configuration includes no calibration), mostly
+    flagged 'disagreement', or samples more than 50 ms apart on average (t not in seconds?).
+    contact_summary() gives the counts.
     """
     est = _estimator_for(source, reading)
     out = _extwrench._estimate(est, t, q, dq, tau, reading)
@@ -100,6 +101,8 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
                                               out["flags"])
         if summary["disagreement_warning"]:
             warnings.warn(summary["disagreement_warning"], EstimateWarning, stacklevel=2)
+        if summary["time_step_note"]:
+            warnings.warn(summary["time_step_note"], EstimateWarning, stacklevel=2)
         if summary["note"] and est.calibration_path is None:
             warnings.warn(summary["note"] + "; in Python: extwrench.calibrate(estimator, "
                           "'FREE.csv', out='CALIB.yaml')", EstimateWarning, stacklevel=2)
@@ -125,8 +128,9 @@ def contact_summary(estimates: Dict[str, Any],
     source: what names the links (a ContactEstimator, Robot, configuration dict or file).
     Returns samples, contact_samples, episodes (contacts declared anew), disagreement_samples,
     by_link {link name: contact samples}, duration [s], text (the command's line "contact: ..."),
-    note (the note to calibrate when the contacts look like the model's error, else "") and
-    disagreement_warning (else "").
+    note (the note to calibrate when the contacts look like the model's error, else ""),
+    disagreement_warning (else "") and time_step_note (when the samples are more than 50 ms
+    apart on average: t not in seconds?, else "").
     """
     est = _estimator_for(source, None)
     return _extwrench._contact_summary(est, estimates["t"], estimates["contact"],

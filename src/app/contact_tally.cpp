@@ -100,4 +100,19 @@ std::string frequent_alarms_note(const ContactTally& tally) {
          "configuration; docs/calibration.md)";
 }
 
+std::string time_step_note(const ContactTally& tally) {
+  constexpr double kLongestMeanStep = 0.05;  // [s]: 20 Hz
+  if (tally.rows < 2) return {};
+  const double step = tally.duration() / static_cast<double>(tally.rows - 1);
+  if (!(step > kLongestMeanStep)) return {};
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "the samples are %.4g s apart on average (%.3g Hz): t must be in seconds "
+                "(docs/log_format.md), and a robot's controller logs at 100 Hz to 1 kHz. If t "
+                "is in milliseconds or counts samples, convert it: the observer and the filters "
+                "integrate over these steps",
+                step, 1.0 / step);
+  return text;
+}
+
 }  // namespace extwrench

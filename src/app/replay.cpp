@@ -244,6 +244,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     const std::string note = frequent_alarms_note(result.contacts);
     if (!note.empty()) messages_of(o) << "extwrench: note: " << title << ": " << note << "\n";
   }
+  if (const std::string note = time_step_note(result.contacts); !note.empty())
+    messages_of(o) << "extwrench: note: " << title << ": " << note << "\n";
   own_outputs.keep();
   return result;
 }

@@ -734,6 +734,24 @@ TEST(FrequentAlarmsNote, SaysCalibrateOnlyForTheModelErrorsPatterns) {
 // The tally behind `estimate`'s line, by hand: a contact on the first sample is an episode, a
 // contact declared without a link counts towards the samples but no link, `disagreement` counts
 // only on contact samples.
+// A log whose t is in milliseconds (or counts samples) is noted; one at 20 Hz or faster is not.
+TEST(TimeStepNote, NamesSecondsForSamplesMoreThan50msApart) {
+  const auto tally = [](long rows, double step) {
+    ContactTally t(8);
+    for (long k = 0; k < rows; ++k) t.add(step * static_cast<double>(k), false, -1, false);
+    return t;
+  };
+  const std::string ms = time_step_note(tally(1000, 1.0));
+  EXPECT_NE(ms.find("the samples are 1 s apart on average (1 Hz): t must be in seconds"),
+            std::string::npos)
+      << ms;
+  EXPECT_NE(time_step_note(tally(100, 0.06)).find("0.06 s apart"), std::string::npos);
+  EXPECT_EQ(time_step_note(tally(1000, 0.05)), "");   // 20 Hz
+  EXPECT_EQ(time_step_note(tally(1000, 0.001)), "");  // 1 kHz
+  EXPECT_EQ(time_step_note(tally(1, 1.0)), "");       // one sample: no step
+  EXPECT_EQ(time_step_note(ContactTally(8)), "");
+}
+
 TEST(ContactTally, CountsSamplesEpisodesAndLinksAsTheLineSays) {
   Model model;
   for (const char* name : {"base", "upper", "lower"}) {

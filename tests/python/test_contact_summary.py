@@ -120,3 +120,31 @@ def test_bad_columns_are_named(robot):
         extwrench.contact_summary(dict(good, t=np.array([0, 1, np.nan, 3, 4.0])), est)
     with pytest.raises(KeyError):
         extwrench.contact_summary({"t": t}, est)
+
+
+def test_a_log_in_milliseconds_gets_the_time_step_note(paper_run, cli, tmp_path):
+    """The paper's log with t written in milliseconds: estimate() warns that the samples are
+    1 s apart and names seconds, and the command notes the same for the same file; in seconds
+    (above) neither says a word."""
+    run = paper_run["dir"]
+    config = run / "ft" / "config.yaml"
+    est = extwrench.ContactEstimator(None, config)
+    lines = (run / "log.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    assert head[0] == "t"
+    rows = [line.split(",", 1) for line in lines[1:2001]]
+    ms = tmp_path / "log_ms.csv"
+    ms.write_text("\n".join([lines[0]] + ["%.12g,%s" % (1e3 * float(t), rest)
+                                          for t, rest in rows]) + "\n")
+    log = extwrench.read_log(ms, est)
+    assert np.diff(log["t"]).mean() == pytest.approx(1.0)
+    with pytest.warns(extwrench.EstimateWarning, match="t must be in seconds") as caught:
+        out = estimate(est, log)
+    messages = [str(w.message) for w in caught if "t must be in seconds" in str(w.message)]
+    assert len(messages) == 1 and messages[0].startswith("the samples are 1 s apart")
+    summary = extwrench.contact_summary(out, est)
+    assert summary["time_step_note"] == messages[0]
+    _, stderr = cli_lines(cli, tmp_path, ["estimate", "--no-figures", "--config", str(config),
+                                          "--log", str(ms), "--out", "ms"])
+    # (the title is the configuration's scheme, as for the other notes)
+    assert "extwrench: note: ft: " + summary["time_step_note"] + "\n" in stderr, stderr

@@ -54,4 +54,10 @@ struct ContactTally {
 /// and configurations without a calibration: the caller decides.
 [[nodiscard]] std::string frequent_alarms_note(const ContactTally& tally);
 
+/// The note for a log whose samples are more than 50 ms apart on average (under 20 Hz, where a
+/// robot's controller logs at 100 Hz to 1 kHz): its t is then likely not in seconds (milliseconds,
+/// a sample counter), and the observer and the filters, which integrate over the time steps,
+/// estimate nothing useful. Empty otherwise (and below two samples).
+[[nodiscard]] std::string time_step_note(const ContactTally& tally);
+
 }  // namespace extwrench
