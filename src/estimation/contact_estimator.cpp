@@ -43,6 +43,21 @@ double settle_time_of(const EstimatorOptions& options, const MomentumObserver& o
   return std::max(kSettleTimeConstants * (slowest + filter), options.detection.min_duration);
 }
 
+// LDLᵀ of B into `factor` and x ← B⁻¹ x, for N joints (6 or 7: most arms) in fixed-size copies
+// whose loops the compiler unrolls: the operations and their order are the general path's, so
+// the bits are too.
+template <int N, typename Factor>
+bool factor_and_solve_fixed(const MatrixX& B, Factor& factor, VectorX& x) noexcept {
+  Eigen::Matrix<double, N, N> A = B;
+  factor = A;  // on failure as the general path leaves it: partly factored is never read
+  if (!ldlt_in_place(A)) return false;
+  Eigen::Matrix<double, N, 1> y = x;
+  ldlt_solve(A, y);
+  x = y;
+  factor = A;
+  return true;
+}
+
 }  // namespace
 
 void ContactEstimator::warm_up() const noexcept { warm_up_geometry(geometry_); }
@@ -291,7 +306,11 @@ Status ContactEstimator::acceleration_route(double dt, const Eigen::Ref<const Ve
   if (inertia_corrected_) data_.M.diagonal() += observer_.inertia_correction();
   ddq_ = tau_eff_ + observer_.residual() - data_.tau;
   bool factored = false;
-  if (n_ <= kInlineJoints) {
+  if (n_ == 7) {
+    factored = factor_and_solve_fixed<7>(data_.M, mass_ldlt_, ddq_);
+  } else if (n_ == 6) {
+    factored = factor_and_solve_fixed<6>(data_.M, mass_ldlt_, ddq_);
+  } else if (n_ <= kInlineJoints) {
     mass_ldlt_ = data_.M;  // fixed capacity: no allocation
     factored = ldlt_in_place(mass_ldlt_);
     if (factored) ldlt_solve(mass_ldlt_, ddq_);

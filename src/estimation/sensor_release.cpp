@@ -9,6 +9,18 @@
 #include "extwrench/estimation/contact_estimator.hpp"
 
 namespace extwrench {
+namespace {
+
+// ldlt_solve_columns for N joints in fixed-size copies (unrolled; the same operations and bits).
+template <int N, typename Factor, typename Columns>
+void solve_columns_fixed(const Factor& factor, Columns& X) noexcept {
+  const Eigen::Matrix<double, N, N> A = factor;
+  Eigen::Matrix<double, N, 4, Eigen::RowMajor> Y = X;
+  ldlt_solve_columns(A, Y);
+  X = Y;
+}
+
+}  // namespace
 
 // 5b. With a base sensor, while a contact on link l (point p of the last sample) is declared:
 // the external force the sensor gives at this instant without the residual's lag
@@ -38,7 +50,11 @@ ContactEstimator::ReleaseForces ContactEstimator::sensor_release_forces(
   point_jacobian(model_, data_, release_link_, p_W, J_);
   minv_jvt_r_.leftCols<3>() = J_.topRows<3>().transpose();
   minv_jvt_r_.col(3) = observer_.residual();
-  if (n_ <= kInlineJoints) {
+  if (n_ == 7) {
+    solve_columns_fixed<7>(mass_ldlt_, minv_jvt_r_);
+  } else if (n_ == 6) {
+    solve_columns_fixed<6>(mass_ldlt_, minv_jvt_r_);
+  } else if (n_ <= kInlineJoints) {
     ldlt_solve_columns(mass_ldlt_, minv_jvt_r_);
   } else {
     data_.mass_llt.solveInPlace(minv_jvt_r_);
