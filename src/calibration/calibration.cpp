@@ -62,6 +62,20 @@ void check_samples(const std::vector<Sample>& samples, int n, bool known_externa
     check(s.tau, "tau");
     if (known_external_torque) check(s.truth.tau_ext, "true_tau_ext");
   }
+  // The fit integrates the momentum over the time steps: a t in milliseconds or a sample counter
+  // (steps a thousand times too long) fits nonsense, which the warnings then blame on contact.
+  constexpr double kLongestMeanStep = 0.05;  // [s]: 20 Hz (time_step_note's, of estimate)
+  if (samples.size() >= 2) {
+    const double step =
+        (samples.back().t - samples.front().t) / static_cast<double>(samples.size() - 1);
+    if (step > kLongestMeanStep) {
+      throw Error("the samples are " + number_text(step, 4) + " s apart on average (" +
+                  number_text(1.0 / step, 3) +
+                  " Hz): t must be in seconds (docs/log_format.md), and calibration needs the "
+                  "controller's rate (100 Hz to 1 kHz); if t is in milliseconds or counts "
+                  "samples, convert it");
+    }
+  }
 }
 
 // With a known external torque: the residual's part due to it, the observer's filter of

@@ -301,6 +301,25 @@ TEST(CalibrationInput, FewerSamplesThanParameters) {
   }
 }
 
+// The same free motion with t written in milliseconds: refused, naming seconds (the fit would
+// integrate over steps a thousand times too long, and its warnings blamed a contact).
+TEST(CalibrationInput, TimeInMillisecondsIsNamed) {
+  auto log = free_log(8.0);
+  const double step = log[1].t - log[0].t;
+  for (Sample& s : log) s.t *= 1e3;
+  try {
+    (void)calibrate(paper_arm(), no_sensor(), log);
+    FAIL();
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("s apart on average"), std::string::npos) << what;
+    EXPECT_NE(what.find("t must be in seconds"), std::string::npos) << what;
+  }
+  for (Sample& s : log) s.t *= 1e-3;  // in seconds again (the log's 1 kHz): calibrates
+  EXPECT_NEAR(log[1].t - log[0].t, step, 1e-12);
+  EXPECT_NO_THROW((void)calibrate(paper_arm(), no_sensor(), log));
+}
+
 TEST(CalibrationInput, NonFiniteSampleIsNamed) {
   auto log = free_log(1.0);
   log[123].tau[1] = std::nan("");
