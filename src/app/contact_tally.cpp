@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "extwrench/core/input_checks.hpp"
+
 namespace extwrench {
 
 ContactTally::ContactTally(int bodies)
@@ -101,10 +103,9 @@ std::string frequent_alarms_note(const ContactTally& tally) {
 }
 
 std::string time_step_note(const ContactTally& tally) {
-  constexpr double kLongestMeanStep = 0.05;  // [s]: 20 Hz
   if (tally.rows < 2) return {};
   const double step = tally.duration() / static_cast<double>(tally.rows - 1);
-  if (!(step > kLongestMeanStep)) return {};
+  if (!(step > kLongestMeanTimeStep)) return {};
   char text[320];
   std::snprintf(text, sizeof text,
                 "the samples are %.4g s apart on average (%.3g Hz): t must be in seconds "

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/core/input_checks.hpp"
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/momentum.hpp"
@@ -64,11 +65,10 @@ void check_samples(const std::vector<Sample>& samples, int n, bool known_externa
   }
   // The fit integrates the momentum over the time steps: a t in milliseconds or a sample counter
   // (steps a thousand times too long) fits nonsense, which the warnings then blame on contact.
-  constexpr double kLongestMeanStep = 0.05;  // [s]: 20 Hz (time_step_note's, of estimate)
   if (samples.size() >= 2) {
     const double step =
         (samples.back().t - samples.front().t) / static_cast<double>(samples.size() - 1);
-    if (step > kLongestMeanStep) {
+    if (step > kLongestMeanTimeStep) {
       throw Error("the samples are " + number_text(step, 4) + " s apart on average (" +
                   number_text(1.0 / step, 3) +
                   " Hz): t must be in seconds (docs/log_format.md), and calibration needs the "
