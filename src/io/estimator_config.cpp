@@ -9,6 +9,7 @@
 #include "extwrench/calibration/calibration.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/calibration_file.hpp"
+#include "extwrench/io/yaml_text.hpp"
 #include "extwrench/model/model_builder.hpp"
 
 namespace extwrench {
@@ -423,12 +424,12 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   std::error_code ec;
   const std::filesystem::path rel = std::filesystem::relative(robot, directory, ec);
   if (!ec && !rel.empty()) robot = rel;
-  y << "robot: " << robot.string() << '\n';
+  y << "robot: " << yaml_scalar(robot.string()) << '\n';
   if (!config.locked_joints.empty()) {
     y << "locked_joints: {";
     const char* sep = "";
     for (const auto& [name, value] : config.locked_joints) {
-      y << sep << name << ": " << value;
+      y << sep << yaml_scalar(name) << ": " << value;
       sep = ", ";
     }
     y << "}\n";

@@ -405,6 +405,26 @@ TEST(CalibrationFile, ReadBackAndWrittenAgainLoadsTheSame) {
   EXPECT_EQ(calibration_to_yaml(again, nullptr), second);
 }
 
+// The log a calibration came from may be named with any bytes (fuzz_calibration_file's finding:
+// a source holding NUL bytes, read from a double-quoted scalar, was written back raw and read
+// back otherwise). Written, read and written again, every such name is itself.
+TEST(CalibrationFile, AnySourceNameReadsBackAsItself) {
+  Calibration cal = calibrate(paper_arm(), no_sensor(), free_log(8.0));
+  const fs::path dir = fs::temp_directory_path() / "extwrench_calibration_source_names";
+  fs::create_directories(dir);
+  using namespace std::string_literals;
+  for (const std::string& source :
+       {"free.csv"s, "a: b #c"s, "nul\0inside"s, "tab\tand\nnewline\r"s, "\x01\x1f\x7f"s,
+        "quote \" and back\\slash"s, "ü"s, ""s, "- [x]"s}) {
+    cal.source = source;
+    std::ofstream(dir / "calib.yaml", std::ios::binary) << calibration_to_yaml(cal, nullptr);
+    const Calibration read = load_calibration(dir / "calib.yaml", 7);
+    EXPECT_EQ(read.source, source);
+    std::ofstream(dir / "again.yaml", std::ios::binary) << calibration_to_yaml(read, nullptr);
+    EXPECT_EQ(load_calibration(dir / "again.yaml", 7).source, source);
+  }
+}
+
 TEST(CalibratedEstimator, UpdateAllocatesNothing) {
   if (!test::allocation_counting_available()) GTEST_SKIP() << "sanitizer build";
   const Model model = paper_arm();

@@ -7,6 +7,8 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/estimator_config.hpp"
+#include "extwrench/io/robot_loader.hpp"
+#include "support/text_files.hpp"
 
 namespace extwrench {
 namespace {
@@ -112,6 +114,32 @@ TEST(EstimatorConfig, WrittenSensorPoseIsAFixedPointOfWritingAndReading) {
     const std::string twice = to_yaml(load_estimator_config_string(once, kDir / "w.yaml"), kDir);
     EXPECT_EQ(once, twice) << "rpy " << rpy;
     EXPECT_EQ(once.find("-0,"), std::string::npos) << once;
+  }
+}
+
+// A robot in a directory whose name YAML would read otherwise (": " starts a mapping, "#" after a
+// space a comment, "[" a sequence): the written configuration quotes the path, and reads back.
+// It was written bare, and the file did not load ("illegal map value").
+TEST(EstimatorConfig, WrittenRobotPathReadsBackWhateverItsCharacters) {
+  const std::string arm = test::read_text(EXTWRENCH_SOURCE_DIR "/models/paper_arm.urdf");
+  for (const char* name : {"arms: v2", "lab #3", "[old]", "yes", "plain_dir-1.0"}) {
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "extwrench_written_robot_path" / name;
+    std::filesystem::create_directories(dir);
+    test::write_text(dir / "arm.urdf", arm);
+    EstimatorConfig a;
+    a.robot_path = dir / "arm.urdf";
+    a.robot = load_robot(a.robot_path);
+    a.options.sensor.type = SensorType::kNone;
+    const std::string text = to_yaml(a, dir.parent_path());
+    const EstimatorConfig b =
+        load_estimator_config_string(text, dir.parent_path() / "written.yaml");
+    EXPECT_EQ(std::filesystem::weakly_canonical(b.robot_path),
+              std::filesystem::weakly_canonical(a.robot_path))
+        << text;
+    if (std::string(name) == "plain_dir-1.0") {
+      EXPECT_NE(text.find("robot: plain_dir-1.0/arm.urdf\n"), std::string::npos) << text;
+    }
   }
 }
 
