@@ -20,8 +20,8 @@
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/log.hpp"
 #include "extwrench/io/number_text.hpp"
+#include "extwrench/io/text_quoting.hpp"
 #include "extwrench/io/urdf_writer.hpp"
-#include "extwrench/io/yaml_text.hpp"
 #include "extwrench/sim/perturb.hpp"
 #include "progress.hpp"
 #include "summary_figure.hpp"
@@ -33,7 +33,7 @@ namespace {
 // with the scenario's own robot in place of the seed's perturbed copy (same links and joints).
 void check_schemes(const Scenario& s, const std::filesystem::path& first_dir) {
   const std::string robot = std::filesystem::absolute(s.robot_path).lexically_normal().string();
-  const std::string quoted = yaml_quoted(robot);
+  const std::string quoted = double_quoted(robot);
   for (const SchemeSpec& scheme : s.schemes) {
     std::string text = scheme_config_yaml(s, scheme);
     const std::string kRobot = "robot: ../model_estimator.urdf\n";

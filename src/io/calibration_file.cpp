@@ -5,7 +5,7 @@
 #include "detail/friction_yaml.hpp"
 #include "detail/yaml_reader.hpp"
 #include "extwrench/core/error.hpp"
-#include "extwrench/io/yaml_text.hpp"
+#include "extwrench/io/text_quoting.hpp"
 
 namespace extwrench {
 namespace io_detail {
@@ -151,7 +151,7 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
   y.precision(17);
   y << "# extwrench calibration (docs/calibration.md). Include it from an estimator\n"
     << "# configuration with `calibration: THIS_FILE`.\n";
-  y << "calibration: {version: 1, source: " << yaml_quoted(c.source) << ", t_begin: " << c.t_begin
+  y << "calibration: {version: 1, source: " << double_quoted(c.source) << ", t_begin: " << c.t_begin
     << ", t_end: " << c.t_end << ", false_alarms_per_hour: " << c.false_alarms_per_hour << "}\n";
   y << "observer: {gain: " << yaml_list(c.observer_gain);
   if ((c.residual_cutoff.array() > 0.0).any())
@@ -193,7 +193,7 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
     for (std::size_t i = 0; i < m.patterns.size(); ++i) {
       const ModelPattern& p = m.patterns[i];
       y << (i ? ",\n    " : "\n    ") << "{kind: " << p.kind << ", joint: " << p.joint
-        << ", share: " << p.share << ", message: " << yaml_quoted(p.message) << '}';
+        << ", share: " << p.share << ", message: " << double_quoted(p.message) << '}';
     }
     y << "]\n";
   }
@@ -219,7 +219,7 @@ std::string calibration_to_yaml(const Calibration& c, const HoldoutReport* holdo
   if (holdout != nullptr) y << holdout_yaml(*holdout);
   y << "warnings: [";
   for (std::size_t i = 0; i < c.warnings.size(); ++i)
-    y << (i ? ", " : "") << yaml_quoted(c.warnings[i]);
+    y << (i ? ", " : "") << double_quoted(c.warnings[i]);
   y << "]\n";
   return y.str();
 }

@@ -9,7 +9,7 @@
 #include "extwrench/calibration/calibration.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/calibration_file.hpp"
-#include "extwrench/io/yaml_text.hpp"
+#include "extwrench/io/text_quoting.hpp"
 #include "extwrench/model/model_builder.hpp"
 
 namespace extwrench {

@@ -5,38 +5,12 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/number_text.hpp"
+#include "extwrench/io/text_quoting.hpp"
 
 namespace extwrench {
 namespace {
 
-std::string str(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
+std::string str(const std::string& s) { return double_quoted(s); }
 
 std::string num(double x) {
   if (!std::isfinite(x)) return "null";

@@ -1,4 +1,4 @@
-#include "extwrench/io/yaml_text.hpp"
+#include "extwrench/io/text_quoting.hpp"
 
 #include <algorithm>
 #include <array>
@@ -7,7 +7,7 @@
 
 namespace extwrench {
 
-std::string yaml_quoted(std::string_view text) {
+std::string double_quoted(std::string_view text) {
   std::string out = "\"";
   out.reserve(text.size() + 2);
   for (const char ch : text) {
@@ -17,9 +17,6 @@ std::string yaml_quoted(std::string_view text) {
         break;
       case '\\':
         out += "\\\\";
-        break;
-      case '\0':
-        out += "\\0";
         break;
       case '\t':
         out += "\\t";
@@ -33,8 +30,8 @@ std::string yaml_quoted(std::string_view text) {
       default: {
         const auto byte = static_cast<unsigned char>(ch);
         if (byte < 0x20 || byte == 0x7F) {
-          char escape[5];
-          std::snprintf(escape, sizeof escape, "\\x%02X", byte);
+          char escape[7];
+          std::snprintf(escape, sizeof escape, "\\u%04X", byte);
           out += escape;
         } else {
           out += ch;
@@ -60,7 +57,7 @@ std::string yaml_scalar(std::string_view text) {
   const bool plain = !text.empty() && text.front() != '-' && text.front() != '+' &&
                      std::all_of(text.begin(), text.end(), safe) &&
                      std::find(kWords.begin(), kWords.end(), lower) == kWords.end();
-  return plain ? std::string(text) : yaml_quoted(text);
+  return plain ? std::string(text) : double_quoted(text);
 }
 
 }  // namespace extwrench
