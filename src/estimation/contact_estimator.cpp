@@ -49,8 +49,7 @@ double settle_time_of(const EstimatorOptions& options, const MomentumObserver& o
 template <int N, typename Factor>
 bool factor_and_solve_fixed(const MatrixX& B, Factor& factor, VectorX& x) noexcept {
   Eigen::Matrix<double, N, N> A = B;
-  factor = A;  // on failure as the general path leaves it: partly factored is never read
-  if (!ldlt_in_place(A)) return false;
+  if (!ldlt_in_place(A)) return false;  // `factor` is then never read (root_wrench_dddq_valid_)
   Eigen::Matrix<double, N, 1> y = x;
   ldlt_solve(A, y);
   x = y;
