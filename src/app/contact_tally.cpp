@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "extwrench/core/input_checks.hpp"
+#include "extwrench/core/time_step.hpp"
 
 namespace extwrench {
 
@@ -103,17 +103,11 @@ std::string frequent_alarms_note(const ContactTally& tally) {
 }
 
 std::string time_step_note(const ContactTally& tally) {
-  if (tally.rows < 2) return {};
-  const double step = tally.duration() / static_cast<double>(tally.rows - 1);
-  if (!(step > kLongestMeanTimeStep)) return {};
-  char text[320];
-  std::snprintf(text, sizeof text,
-                "the samples are %.4g s apart on average (%.3g Hz): t must be in seconds "
-                "(docs/log_format.md), and a robot's controller logs at 100 Hz to 1 kHz. If t "
-                "is in milliseconds or counts samples, convert it: the observer and the filters "
-                "integrate over these steps",
-                step, 1.0 / step);
-  return text;
+  const std::string slow = slow_time_step(tally.t_begin, tally.t_end, tally.rows);
+  if (slow.empty()) return {};
+  return slow +
+         ", and a robot's controller logs at 100 Hz to 1 kHz. If t is in milliseconds or counts "
+         "samples, convert it: the observer and the filters integrate over these steps";
 }
 
 }  // namespace extwrench

@@ -6,7 +6,7 @@
 #include <string>
 
 #include "extwrench/core/error.hpp"
-#include "extwrench/core/input_checks.hpp"
+#include "extwrench/core/time_step.hpp"
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/momentum.hpp"
@@ -65,15 +65,13 @@ void check_samples(const std::vector<Sample>& samples, int n, bool known_externa
   }
   // The fit integrates the momentum over the time steps: a t in milliseconds or a sample counter
   // (steps a thousand times too long) fits nonsense, which the warnings then blame on contact.
-  if (samples.size() >= 2) {
-    const double step =
-        (samples.back().t - samples.front().t) / static_cast<double>(samples.size() - 1);
-    if (step > kLongestMeanTimeStep) {
-      throw Error("the samples are " + number_text(step, 4) + " s apart on average (" +
-                  number_text(1.0 / step, 3) +
-                  " Hz): t must be in seconds (docs/log_format.md), and calibration needs the "
-                  "controller's rate (100 Hz to 1 kHz); if t is in milliseconds or counts "
-                  "samples, convert it");
+  if (!samples.empty()) {
+    const std::string slow =
+        slow_time_step(samples.front().t, samples.back().t, static_cast<long>(samples.size()));
+    if (!slow.empty()) {
+      throw Error(slow +
+                  ", and calibration needs the controller's rate (100 Hz to 1 kHz); if t is in "
+                  "milliseconds or counts samples, convert it");
     }
   }
 }

@@ -9,11 +9,6 @@
 
 namespace extwrench {
 
-/// The longest mean time step [s] of a log taken as timed in seconds: 50 ms (20 Hz, where a
-/// robot's controller logs at 100 Hz to 1 kHz). Beyond it t is likely in milliseconds or counts
-/// samples: `estimate` notes it (time_step_note), `calibrate` refuses the log.
-inline constexpr double kLongestMeanTimeStep = 0.05;
-
 /// ok when v has n entries, all finite; else kWrongSize (index = v's size) or kNonFinite (index
 /// of the first bad entry) on `channel`.
 [[nodiscard]] inline Status check_vector(const Eigen::Ref<const VectorX>& v, int n,
