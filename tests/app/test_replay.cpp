@@ -731,9 +731,6 @@ TEST(FrequentAlarmsNote, SaysCalibrateOnlyForTheModelErrorsPatterns) {
   EXPECT_EQ(frequent_alarms_note(result(9752, 300, 9, 10.5, {0, 100, 100, 100, 0, 0, 0, 0})), "");
 }
 
-// The tally behind `estimate`'s line, by hand: a contact on the first sample is an episode, a
-// contact declared without a link counts towards the samples but no link, `disagreement` counts
-// only on contact samples.
 // A log whose t is in milliseconds (or counts samples) is noted; one at 20 Hz or faster is not.
 TEST(TimeStepNote, NamesSecondsForSamplesMoreThan50msApart) {
   const auto tally = [](long rows, double step) {
@@ -752,6 +749,9 @@ TEST(TimeStepNote, NamesSecondsForSamplesMoreThan50msApart) {
   EXPECT_EQ(time_step_note(ContactTally(8)), "");
 }
 
+// The tally behind `estimate`'s line, by hand: a contact on the first sample is an episode, a
+// contact declared without a link counts towards the samples but no link, `disagreement` counts
+// only on contact samples.
 TEST(ContactTally, CountsSamplesEpisodesAndLinksAsTheLineSays) {
   Model model;
   for (const char* name : {"base", "upper", "lower"}) {
