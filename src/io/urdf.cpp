@@ -110,6 +110,33 @@ class UrdfParser {
     throw Error(context(e, owner) + ": " + what);
   }
 
+  // validate_inertia on the numbers as the file writes them (the model checks them again in the
+  // link frame), so that the message can point at them: exported and Gazebo files often carry
+  // placeholder products of inertia (0.01 beside moments of 0.002) that make a tensor
+  // non-physical while its diagonal alone is fine.
+  void check_inertia_as_written(const Inertia& in, const XMLElement* e,
+                                const std::string& owner) const {
+    try {
+      validate_inertia(in, "");
+    } catch (const Error& error) {
+      std::string what = error.what();
+      Inertia diagonal = in;
+      diagonal.inertia_com = in.inertia_com.diagonal().asDiagonal();
+      bool diagonal_physical = true;
+      try {
+        validate_inertia(diagonal, "");
+      } catch (const Error&) {
+        diagonal_physical = false;
+      }
+      if (diagonal_physical) {
+        what += "; ixx, iyy, izz alone would be physical: are the products ixy, ixz, iyz (" +
+                shown(e->Attribute("ixy")) + ", " + shown(e->Attribute("ixz")) + ", " +
+                shown(e->Attribute("iyz")) + ") placeholders? (write 0 where unknown)";
+      }
+      fail(e, owner, what);
+    }
+  }
+
   const char* required(const XMLElement* e, const char* attr, const std::string& owner) const {
     const char* v = e->Attribute(attr);
     if (v == nullptr) fail(e, owner, std::string("attribute '") + attr + "': missing (required)");
@@ -182,6 +209,7 @@ class UrdfParser {
       const double iyz = number(inertia, "iyz", owner, std::nullopt);
       const double izz = number(inertia, "izz", owner, std::nullopt);
       in.inertia_com << ixx, ixy, ixz, ixy, iyy, iyz, ixz, iyz, izz;
+      check_inertia_as_written(in, inertia, owner);
       link.inertia = in.transformed(X_link_inertial);
       link.inertia_source = where(inertia) + ": <inertial>";
     }

@@ -35,7 +35,12 @@ const std::map<std::string, Expected>& cases() {
       {"inertia_not_a_number.urdf",
        {12, {"<inertia> of link 'arm'", "attribute 'ixx'", "got 'abc'"}}},
       {"inertia_missing_iyz.urdf", {12, {"<inertia> of link 'arm'", "attribute 'iyz': missing"}}},
-      {"inertia_not_psd.urdf", {12, {"link 'arm'", "inertia: not positive semi-definite"}}},
+      // ixx, iyy, izz are physical, ixy is not: the message points at the products.
+      {"inertia_not_psd.urdf",
+       {12,
+        {"<inertia> of link 'arm'", "inertia: not positive semi-definite",
+         "ixx, iyy, izz alone would be physical: are the products ixy, ixz, iyz (0.5, 0, 0) "
+         "placeholders?"}}},
       {"inertia_triangle.urdf",
        {12, {"link 'arm'", "inertia: principal moments violate the triangle inequality"}}},
       {"inertia_nan.urdf", {12, {"<inertia> of link 'arm'", "attribute 'ixx'", "got 'nan'"}}},

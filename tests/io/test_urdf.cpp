@@ -59,6 +59,47 @@ TEST(Urdf, InertialOriginIsConvertedToTheLinkFrame) {
   EXPECT_TRUE(std::isinf(m.joints[1].lower));
 }
 
+TEST(Urdf, NonPhysicalInertiaPointsAtTheProductsOnlyWhenTheDiagonalIsPhysical) {
+  // The inertial frame is rotated, so the link-frame tensor has other products than the file:
+  // the message quotes the file's.
+  const auto xml = [](const std::string& inertia) {
+    return R"(<robot name="r">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="arm">
+    <inertial>
+      <origin xyz="0 0 0" rpy="0.3 0.2 0.1"/>
+      <mass value="2"/>
+      )" + inertia +
+           R"(
+    </inertial>
+  </link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/></joint>
+</robot>)";
+  };
+  const auto error = [](const std::string& urdf) {
+    try {
+      (void)load_urdf_string(urdf, "inline.urdf", no_meshes());
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string products = error(
+      xml(R"(<inertia ixx="0.01" ixy="0.01" ixz="1e-2" iyy="0.002" iyz="0.01" izz="0.01"/>)"));
+  EXPECT_NE(products.find("inline.urdf:7: <inertia> of link 'arm': inertia: not positive "
+                          "semi-definite"),
+            std::string::npos)
+      << products;
+  EXPECT_NE(products.find("are the products ixy, ixz, iyz (0.01, 1e-2, 0.01) placeholders?"),
+            std::string::npos)
+      << products;
+  // The diagonal itself breaks the triangle inequality: no products to blame.
+  const std::string diagonal =
+      error(xml(R"(<inertia ixx="0.01" ixy="0.001" ixz="0" iyy="0.01" iyz="0" izz="0.1"/>)"));
+  EXPECT_NE(diagonal.find("triangle inequality"), std::string::npos) << diagonal;
+  EXPECT_EQ(diagonal.find("placeholders"), std::string::npos) << diagonal;
+}
+
 TEST(Urdf, JointLimitsDynamicsAndDefaultsAreKept) {
   const std::string xml = R"(<robot name="r">
   <link name="a"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
@@ -222,6 +263,10 @@ TEST(UrdfShared, EveryUrdfLoadsExceptTheGazLwrWithItsNonPhysicalInertias) {
       // lwr_1_link is the first link (in file order) whose inertia is not physical.
       EXPECT_NE(msg.find("link 'lwr_1_link'"), std::string::npos) << name << ": " << msg;
       EXPECT_NE(msg.find("not positive semi-definite"), std::string::npos) << name << ": " << msg;
+      // Its diagonal is physical; the file's products are 0.01 (placeholders).
+      EXPECT_NE(msg.find("are the products ixy, ixz, iyz (0.01, 0.01, 0.01) placeholders?"),
+                std::string::npos)
+          << msg;
       EXPECT_NE(msg.find(name + ":"), std::string::npos) << msg;
       continue;
     }
