@@ -12,7 +12,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -29,6 +28,7 @@
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/io/urdf_writer.hpp"
 #include "extwrench/sim/perturb.hpp"
+#include "support/error_of.hpp"
 #include "support/random.hpp"
 #include "support/text_files.hpp"
 
@@ -36,6 +36,7 @@ namespace extwrench {
 namespace {
 
 namespace fs = std::filesystem;
+using test::error_of;
 using test::read_text;
 using test::write_text;
 
@@ -48,15 +49,6 @@ fs::path temp_dir(const std::string& name) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 class Replay : public ::testing::Test {

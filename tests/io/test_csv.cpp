@@ -16,27 +16,18 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/csv.hpp"
+#include "support/error_of.hpp"
 #include "support/random.hpp"
 
 namespace extwrench {
 namespace {
 
+using test::error_of;
+
 /// Passes when `needle` occurs in `text`; prints both otherwise.
 ::testing::AssertionResult contains(const std::string& text, const std::string& needle) {
   if (text.find(needle) != std::string::npos) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << needle << "'";
-}
-
-/// The message of the extwrench::Error that `f` throws ("" and a test failure if none).
-template <typename F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an extwrench::Error";
-  return "";
 }
 
 /// Reads every row of `text`, converting every cell with number(): the error it throws.
