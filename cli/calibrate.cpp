@@ -39,6 +39,10 @@ void run_calibrate(const CalibrateOptions& opt) {
   } catch (const Error& e) {
     throw UsageError(e.what());  // a bad option: exit code 2
   }
+  refuse_dash(opt.out, "--out",
+              "calibrate writes CALIB.yaml to a file, not to standard output (its report goes "
+              "there); give a file path");
+  check_output_file(opt.out, "--out", {opt.config, opt.log});
   LoadOptions load;
   load.package_path = opt.package_path;
   const EstimatorConfig config = load_estimator_config(opt.config, load);

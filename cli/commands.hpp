@@ -62,6 +62,17 @@ void add_lock_option(CLI::App& sub, std::vector<std::string>& locks);
 /// "xyz (x, y, z) m, rpy (r, p, y) rad" of a pose, for the start-up messages.
 [[nodiscard]] std::string pose_summary(const Pose& X);
 
+/// Checks an output file named on the command line before any work: `option` (e.g. "--out")
+/// must name a file that OutputFiles can write (not a directory, symbolic link, device or FIFO)
+/// and none of `inputs` (the same file would be overwritten while, or after, it is read).
+void check_output_file(const std::filesystem::path& out, const std::string& option,
+                       std::initializer_list<std::filesystem::path> inputs);
+
+/// "-" for --out of a command that writes a file or a directory, not standard output: a usage
+/// error "OPTION -: WHAT" (a file or directory named "-" is never what was meant).
+void refuse_dash(const std::filesystem::path& out, const std::string& option,
+                 const std::string& what);
+
 /// Adds `--figure-format png|svg|pdf` to a subcommand.
 void add_figure_format_option(CLI::App& sub, std::string& format);
 

@@ -12,6 +12,7 @@
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/input_file.hpp"
 #include "extwrench/io/number_text.hpp"
+#include "extwrench/io/output_files.hpp"
 
 namespace extwrench::cli {
 
@@ -98,6 +99,29 @@ Pose default_sensor_pose(const Model& model, std::string* description) {
 
 std::string pose_summary(const Pose& X) {
   return "xyz " + fmt(X.translation) + " m, rpy " + fmt(rpy_from_rotation(X.rotation)) + " rad";
+}
+
+void check_output_file(const std::filesystem::path& out, const std::string& option,
+                       std::initializer_list<std::filesystem::path> inputs) {
+  try {
+    OutputFiles::check_file_target(out);
+  } catch (const Error& e) {
+    throw Error(option + " " + e.what());
+  }
+  std::error_code ec;
+  for (const std::filesystem::path& in : inputs) {
+    if (std::filesystem::equivalent(out, in, ec)) {
+      throw Error(option + " " + out.string() + ": is the input file " + in.string() +
+                  "; give another path (it would be overwritten)");
+    }
+  }
+}
+
+void refuse_dash(const std::filesystem::path& out, const std::string& option,
+                 const std::string& what) {
+  if (out == "-") {
+    throw UsageError(option + " -: " + what);
+  }
 }
 
 void add_figure_format_option(CLI::App& sub, std::string& format) {

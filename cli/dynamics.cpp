@@ -45,6 +45,8 @@ void run_dynamics(const DynamicsOptions& opt) {
   // Check the command line before any file is touched: a usage error is reported first.
   std::optional<Pose> given_pose;
   if (opt.sensor_pose_given) given_pose = parse_pose(opt.sensor_pose, "--sensor-pose");
+  const std::filesystem::path out_path(opt.out);
+  if (opt.out != "-") check_output_file(out_path, "--out", {opt.robot, opt.in});
 
   const RobotDescription robot =
       load_robot_file(opt.robot, robot_load_options(opt.package_path, opt.lock));
@@ -86,7 +88,8 @@ void run_dynamics(const DynamicsOptions& opt) {
 
   // OUT.csv.partial until complete: a failed run leaves nothing that looks like a result.
   OutputFiles outputs;
-  const std::filesystem::path out_path(opt.out);
+  if (opt.out != "-" && out_path.has_parent_path())
+    outputs.create_directories(out_path.parent_path());
   std::unique_ptr<CsvWriter> writer =
       opt.out == "-" ? std::make_unique<CsvWriter>(std::cout, output_columns(n), "<stdout>")
                      : std::make_unique<CsvWriter>(outputs.stage(out_path), output_columns(n));

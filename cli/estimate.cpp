@@ -168,6 +168,13 @@ ReplayOptions replay_options(const EstimateOptions& opt, const std::string& desc
 }
 
 void run_estimate(const EstimateOptions& opt) {
+  refuse_dash(opt.out, "--out",
+              "estimate writes a directory of files, not standard output; give a directory path");
+  // NaN fails every comparison: say so, not that the other bound is out of order.
+  if (std::isnan(opt.metrics_from))
+    throw UsageError("--metrics-from: expected a time in seconds, got nan");
+  if (std::isnan(opt.metrics_to))
+    throw UsageError("--metrics-to: expected a time in seconds, got nan");
   if (!(opt.metrics_from < opt.metrics_to)) {
     throw UsageError("--metrics-to " + format_number(opt.metrics_to) +
                      " must come after --metrics-from " + format_number(opt.metrics_from) +

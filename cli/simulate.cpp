@@ -87,6 +87,8 @@ void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
 }
 
 void run_simulate(const SimulateOptions& opt) {
+  refuse_dash(opt.out, "--out",
+              "simulate writes a directory of files, not standard output; give a directory path");
   const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
   const Scenario scenario = load_scenario(opt.scenario, load);
   const Pose& X_WS = scenario.simulation.sensor.X_WS;

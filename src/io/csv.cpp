@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -19,6 +20,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/input_file.hpp"
 #include "extwrench/io/number_text.hpp"
+#include "extwrench/io/output_files.hpp"
 
 namespace extwrench {
 namespace {
@@ -343,11 +345,17 @@ double CsvReader::number_or_nan(int column) const {
 // ------------------------------------------------------------------------------------------
 // CsvWriter
 
+namespace {
+std::unique_ptr<std::ofstream> open_truncated(const std::filesystem::path& path) {
+  errno = 0;  // so that a failure's errno is open(2)'s
+  auto out = std::make_unique<std::ofstream>(path, std::ios::binary | std::ios::trunc);
+  if (!*out) throw Error(OutputFiles::cannot_create(path, errno));
+  return out;
+}
+}  // namespace
+
 CsvWriter::CsvWriter(const std::filesystem::path& path, std::vector<std::string> header)
-    : owned_stream_(std::make_unique<std::ofstream>(path, std::ios::binary | std::ios::trunc)),
-      name_(path.string()),
-      header_(std::move(header)) {
-  if (!*owned_stream_) throw Error(name_ + ": cannot create the file");
+    : owned_stream_(open_truncated(path)), name_(path.string()), header_(std::move(header)) {
   out_ = owned_stream_.get();
   if (header_.empty()) throw Error(name_ + ": a CSV file needs at least one column");
   for (const auto& h : header_) add(std::string_view(h));

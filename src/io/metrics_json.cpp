@@ -1,10 +1,12 @@
 #include "extwrench/io/metrics_json.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <fstream>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/number_text.hpp"
+#include "extwrench/io/output_files.hpp"
 #include "extwrench/io/text_quoting.hpp"
 
 namespace extwrench {
@@ -89,8 +91,9 @@ std::string metrics_json(const MetricsReport& r) {
 }
 
 void write_metrics_json(const std::filesystem::path& path, const MetricsReport& report) {
+  errno = 0;
   std::ofstream out(path);
-  if (!out) throw Error(path.string() + ": cannot create the file");
+  if (!out) throw Error(OutputFiles::cannot_create(path, errno));
   out << metrics_json(report);
   if (!out) throw Error(path.string() + ": write failed");
 }

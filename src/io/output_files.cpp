@@ -39,16 +39,44 @@ fs::path OutputFiles::partial_name(const fs::path& path) {
   return p;
 }
 
+void OutputFiles::check_file_target(const fs::path& path) {
+  const std::string name = path.string();
+  if (path.empty()) throw Error("an output file needs a name (got an empty path)");
+  if (!path.has_filename()) {
+    throw Error(name + ": names a directory (it ends with '/'); give a file name in it");
+  }
+  std::error_code ec;
+  const fs::file_status link = fs::symlink_status(path, ec);
+  if (ec || !fs::exists(link)) return;  // a new file (a missing directory is created or reported)
+  if (fs::is_symlink(link)) {
+    const fs::path target = fs::read_symlink(path, ec);
+    throw Error(name + ": is a symbolic link" +
+                (ec ? std::string() : " (to " + target.string() + ")") +
+                ": the finished file is renamed into place, which would replace the link, not the "
+                "file it points to; give that file's path");
+  }
+  if (fs::is_directory(link)) {
+    throw Error(name + ": is a directory; give a file name in it");
+  }
+  if (!fs::is_regular_file(link)) {
+    throw Error(name +
+                ": exists and is not a regular file (a device, FIFO or socket): the "
+                "finished file is renamed into place, which would replace it; give another "
+                "path");
+  }
+}
+
+std::string OutputFiles::cannot_create(const fs::path& path, int reason) {
+  return path.string() + ": cannot create the file" +
+         (reason != 0 ? std::string(": ") + std::strerror(reason) : std::string());
+}
+
 void OutputFiles::write_text(const fs::path& path, std::string_view text) {
   const fs::path partial = stage(path);
   {
     errno = 0;
     std::ofstream out(partial);
-    if (!out) {
-      const int reason = errno;  // open(2)'s, when it failed there
-      throw Error(partial.string() + ": cannot create the file" +
-                  (reason != 0 ? std::string(": ") + std::strerror(reason) : std::string()));
-    }
+    if (!out) throw Error(cannot_create(partial, errno));  // errno: open(2)'s, when it failed
     out << text;
     out.flush();
     if (!out) throw Error(partial.string() + ": write failed (disk full?)");
@@ -57,6 +85,7 @@ void OutputFiles::write_text(const fs::path& path, std::string_view text) {
 }
 
 fs::path OutputFiles::stage(const fs::path& path) {
+  check_file_target(path);
   staged_.push_back(path);
   return partial_name(path);
 }

@@ -300,6 +300,74 @@ TEST_F(Hostile, OutputToAFullDeviceIsAnErrorNotASuccess) {
   }
 }
 
+TEST_F(Hostile, AnOutputThatIsNotAPlainFileIsRefusedAndLeftAlone) {
+  // The finished file is renamed into place: over a FIFO or a device it would replace them by a
+  // plain file (as root, `--out /dev/full` once did), over a symbolic link it would replace the
+  // link and leave its target unwritten. (A FIFO stands for the device here: an old build must
+  // not break /dev/full when this test runs it.)
+  write_text(path("states.csv"),
+             "t,q1,q2,q3,q4,q5,q6,q7,dq1,dq2,dq3,dq4,dq5,dq6,dq7,ddq1,ddq2,ddq3,"
+             "ddq4,ddq5,ddq6,ddq7\n0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0,0\n");
+  ASSERT_EQ(mkfifo(path("fifo").c_str(), 0600), 0);
+  write_text(path("target.csv"), "kept\n");
+  fs::create_symlink("target.csv", path("link.csv"));
+  fs::create_directories(path("dir"));
+  const std::string dynamics =
+      "dynamics --robot " + q(kPaperArm) + " --in " + q(path("states.csv")) + " --out ";
+  struct Case {
+    std::string out, expected;
+  };
+  for (const Case& c : {Case{q(path("fifo")), "fifo: exists and is not a regular file"},
+                        Case{q(path("link.csv")), "link.csv: is a symbolic link (to target.csv)"},
+                        Case{q(path("dir")), "dir: is a directory; give a file name in it"},
+                        Case{q(path("dir")) + "/", "names a directory (it ends with '/')"},
+                        Case{q(path("states.csv")), "states.csv: is the input file"}}) {
+    const CliRun r = run(dynamics + c.out);
+    EXPECT_EQ(r.code, 1) << c.out;
+    EXPECT_TRUE(contains(r.err, "--out ")) << c.out;
+    EXPECT_TRUE(contains(r.err, c.expected)) << c.out;
+  }
+  EXPECT_TRUE(fs::is_fifo(path("fifo")));
+  EXPECT_TRUE(fs::is_symlink(path("link.csv")));
+  EXPECT_EQ(read_text(path("target.csv")), "kept\n");
+  EXPECT_EQ(read_text(path("states.csv")).substr(0, 5), "t,q1,");
+  EXPECT_EQ(listing(path("dir")), "");
+  // calibrate refuses before the fit, and its own input as output.
+  write_log(path("log.csv"), 2'000);
+  write_text(path("config.yaml"), "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  const std::string calibrate =
+      "calibrate --config " + q(path("config.yaml")) + " --log " + q(path("log.csv")) + " --out ";
+  const CliRun fifo = run(calibrate + q(path("fifo")));
+  EXPECT_EQ(fifo.code, 1);
+  EXPECT_TRUE(contains(fifo.err, "fifo: exists and is not a regular file"));
+  const CliRun log = run(calibrate + q(path("log.csv")));
+  EXPECT_EQ(log.code, 1);
+  EXPECT_TRUE(contains(log.err, "log.csv: is the input file"));
+  // `-` is standard output for dynamics only: elsewhere a file or directory named "-" is never
+  // what was meant.
+  const std::string here = "cd " + q(dir_) + " &&";
+  const CliRun dash = run(calibrate + "-", here);
+  EXPECT_EQ(dash.code, 2);
+  EXPECT_TRUE(contains(dash.err, "--out -: calibrate writes CALIB.yaml to a file"));
+  const CliRun estimate = run(
+      "estimate --config " + q(path("config.yaml")) + " --log " + q(path("log.csv")) + " --out -",
+      here);
+  EXPECT_EQ(estimate.code, 2);
+  EXPECT_TRUE(contains(estimate.err, "--out -: estimate writes a directory of files"));
+  EXPECT_FALSE(fs::exists(path("-")));
+}
+
+TEST_F(Hostile, ANonNumericMetricsWindowNamesItsOwnOption) {
+  // NaN compares false with everything: the message once said the other bound was out of order.
+  const std::string estimate = "estimate --config c.yaml --log l.csv --out o ";
+  const CliRun from = run(estimate + "--metrics-from nan");
+  EXPECT_EQ(from.code, 2);
+  EXPECT_TRUE(contains(from.err, "--metrics-from: expected a time in seconds, got nan"));
+  const CliRun to = run(estimate + "--metrics-to nan");
+  EXPECT_EQ(to.code, 2);
+  EXPECT_TRUE(contains(to.err, "--metrics-to: expected a time in seconds, got nan"));
+}
+
 TEST_F(Hostile, AnInvalidConfigurationOfEstimateIsRejectedBeforeAnythingIsWritten) {
   write_log(path("log.csv"), 1'000);
   write_text(path("config.yaml"),

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -40,6 +41,14 @@ class OutputFiles {
 
   /// "<path>.partial".
   static std::filesystem::path partial_name(const std::filesystem::path& path);
+  /// Throws extwrench::Error unless `path` can be written by stage() and commit(): it must not
+  /// name a directory (or end with '/'), a symbolic link (the rename would replace the link, not
+  /// the file it points to) or an existing file that is not regular (a device, a FIFO: the
+  /// rename would replace /dev/full by a plain file). stage() checks it; commands call it before
+  /// their work, so that a bad --out fails at once.
+  static void check_file_target(const std::filesystem::path& path);
+  /// "PATH: cannot create the file[: REASON]", REASON from errno when open(2) set it.
+  static std::string cannot_create(const std::filesystem::path& path, int reason);
 
  private:
   std::vector<std::filesystem::path> staged_;
