@@ -1,6 +1,7 @@
 #include "arrays.hpp"
 
 #include <cmath>
+#include <cstdint>
 
 namespace extwrench::python {
 
@@ -51,6 +52,17 @@ RealArray real_array(const py::handle& obj, const char* name, int ndim) {
   if (arr.ndim() != ndim) {
     throw py::value_error(std::string(name) + ": expected a " + std::to_string(ndim) +
                           "-D array, got " + std::to_string(arr.ndim()) + "-D");
+  }
+  // A field of a packed structured array (itemsize 12: an f8 beside an i4) has byte strides
+  // that are no multiple of 8, and its data may be unaligned: strides in elements cannot say
+  // that, so such an array is read through an aligned C-order copy.
+  constexpr auto kSize = static_cast<py::ssize_t>(sizeof(double));
+  bool elementwise = reinterpret_cast<std::uintptr_t>(arr.data()) % alignof(double) == 0;
+  for (py::ssize_t d = 0; d < arr.ndim(); ++d)
+    elementwise = elementwise && arr.strides(d) % kSize == 0;
+  if (!elementwise) {
+    arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(arr);
+    if (!arr) throw py::error_already_set();
   }
   RealArray out;
   out.data = static_cast<const double*>(arr.data());

@@ -18,6 +18,7 @@ Estimator::Estimator(EstimatorConfig c) : config(std::move(c)), estimator(make_e
 }
 
 std::string status_text(Status s) {
+  if (s.ok()) return "ok";  // the flags are Estimate.flags; the CSV's column shows them instead
   ContactEstimate e;
   e.status = s;
   return EstimatesWriter::status_text(e);

@@ -38,7 +38,8 @@ struct Estimate {
                                       const py::handle& q, const py::handle& dq,
                                       const py::handle& tau, const py::handle& reading);
 
-/// Python's status text of a Status ("non_finite:q[2]"), as in estimates.csv.
+/// Python's status text of a Status: "ok", or the outcome as in estimates.csv ("non_finite:q[2]";
+/// the CSV's column shows the flags where the status is ok).
 [[nodiscard]] std::string status_text(Status s);
 
 void bind_batch(py::module_& m);
