@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 
 namespace extwrench::python {
 
@@ -110,7 +111,8 @@ void read_vector(const py::handle& obj, const char* name, Eigen::Index n, Vector
       const py::ssize_t stride = arr.strides(0);
       if (out.size() != n) out.resize(n);
       for (Eigen::Index i = 0; i < n; ++i) {
-        const double v = *reinterpret_cast<const double*>(p + i * stride);
+        double v;  // memcpy: a field of a packed structured array may be unaligned
+        std::memcpy(&v, p + i * stride, sizeof v);
         if (!std::isfinite(v)) {
           throw py::value_error(std::string(name) + "[" + std::to_string(i) + "] is " +
                                 number_text(v));
