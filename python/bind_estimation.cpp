@@ -100,7 +100,7 @@ std::unique_ptr<Estimator> make(const py::object& robot, const py::object& confi
           "config: robot: give the robot either as the argument or as the "
           "config's 'robot' key, not both");
     }
-    if (r != nullptr) d["robot"] = std::filesystem::absolute(r->description.source).string();
+    if (r != nullptr) d["robot"] = r->absolute_source.string();
     return std::make_unique<Estimator>(load_estimator_config_string(json_text(d), "config", load));
   }
   if (!py::isinstance<py::str>(config) && !py::hasattr(config, "__fspath__")) {
@@ -108,9 +108,13 @@ std::unique_ptr<Estimator> make(const py::object& robot, const py::object& confi
   }
   auto e = std::make_unique<Estimator>(
       load_estimator_config(config.cast<std::filesystem::path>(), load));
-  if (r != nullptr && e->nq() != r->nq()) {
-    throw py::value_error("config: its robot has " + std::to_string(e->nq()) +
-                          " joints, the robot given has " + std::to_string(r->nq()));
+  // The Robot's load options (gravity, locks) were applied to the configuration's robot file:
+  // that must be the Robot's own file, not merely one with as many joints.
+  std::error_code ec;
+  if (r != nullptr && !std::filesystem::equivalent(e->config.robot_path, r->absolute_source, ec)) {
+    throw py::value_error("config: its robot is " + e->config.robot_path.string() +
+                          ", the robot given was loaded from " + r->absolute_source.string() +
+                          " (give the configuration alone, or the robot with a config dict)");
   }
   return e;
 }

@@ -5,6 +5,7 @@
 
 #include <pybind11/pybind11.h>
 
+#include <filesystem>
 #include <memory>
 
 #include "extwrench/dynamics/data.hpp"
@@ -17,6 +18,9 @@ namespace py = pybind11;
 struct Robot {
   RobotDescription description;
   LoadOptions options;
+  /// The file it was loaded from, made absolute when it was loaded: an estimator configured
+  /// from this Robot later loads that file, whatever the working directory is by then.
+  std::filesystem::path absolute_source;
   std::unique_ptr<Data> data;  ///< the workspace of the dynamics functions (the GIL guards it)
   VectorX q, dq, ddq, tau;     ///< argument buffers, sized once
 

@@ -205,6 +205,42 @@ def test_other_setup_errors(robot, tmp_path):
         extwrench.ContactEstimator(robot, {"sensor": {"type": "ft"}, "observer": {"gain": object()}})
 
 
+def test_an_estimator_from_a_robot_uses_that_robot(robot, tmp_path, monkeypatch):
+    # The same file name in another directory, with another robot in it (the paper arm 1 kg
+    # heavier on link 2): a relative path is resolved where the Robot was loaded, not where the
+    # estimator is built.
+    (tmp_path / "a" / "models").mkdir(parents=True)
+    (tmp_path / "b" / "models").mkdir(parents=True)
+    text = PAPER_URDF.read_text()
+    (tmp_path / "a" / "models" / "arm.urdf").write_text(text)
+    heavier = text.replace('<mass value="', '<mass value="1', 3)
+    assert heavier != text
+    (tmp_path / "b" / "models" / "arm.urdf").write_text(heavier)
+    monkeypatch.chdir(tmp_path / "a")
+    loaded = extwrench.load_robot("models/arm.urdf")
+    monkeypatch.chdir(tmp_path / "b")
+    est = extwrench.ContactEstimator(loaded, {"sensor": {"type": "none"}})
+    assert str(est.robot_path) == str(tmp_path / "a" / "models" / "arm.urdf")
+    q = np.full(loaded.nq, 0.3)
+    zero = np.zeros(loaded.nq)
+    tau = extwrench.gravity(loaded, q)
+    est.reset(0.0, q, zero, tau)
+    for k in range(1, 50):
+        assert not est.update(1e-3 * k, q, zero, tau).contact
+    # A configuration file of another robot with this Robot: refused, not merely nq compared.
+    config = tmp_path / "b" / "config.yaml"
+    config.write_text("robot: models/arm.urdf\nsensor: {type: none}\n")
+    with pytest.raises(ValueError, match="the robot given was loaded from"):
+        extwrench.ContactEstimator(loaded, str(config))
+    assert extwrench.ContactEstimator(robot, str(_config_of(tmp_path, PAPER_URDF))).nq == 7
+
+
+def _config_of(tmp_path, urdf):
+    path = tmp_path / "same.yaml"
+    path.write_text("robot: %s\nsensor: {type: none}\n" % urdf)
+    return path
+
+
 def run(est, log, skip_bad=None):
     t, q, dq, tau, reading = log
     est.reset(t[0], q[0], dq[0], tau[0])
