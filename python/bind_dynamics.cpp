@@ -2,6 +2,8 @@
 #include <pybind11/eigen.h>
 #include <pybind11/stl.h>
 
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "arrays.hpp"
@@ -64,13 +66,30 @@ py::array_t<double> forward_kinematics_py(Robot& r, const py::handle& q) {
   return out;
 }
 
+// The frame `body` names when it is a name but not a body's.
+std::optional<int> frame_not_body(const Model& m, const py::object& body) {
+  if (!py::isinstance<py::str>(body)) return std::nullopt;
+  const auto name = body.cast<std::string>();
+  for (const Body& b : m.bodies)
+    if (b.name == name) return std::nullopt;
+  return m.find_frame(name);
+}
+
 py::array_t<double> jacobian_py(Robot& r, const py::handle& q, const py::object& body,
                                 const py::object& point_W) {
   const int b = r.body(body, "body");
   read_vector(q, "q", r.nq(), r.q);
   forward_kinematics(r.model(), *r.data, r.q);
-  if (point_W.is_none()) return to_numpy(body_jacobian(r.model(), *r.data, b));
-  point_jacobian(r.model(), *r.data, b, read_vector3(point_W, "point_W"), r.data->J);
+  Vector3 point;
+  if (!point_W.is_none()) {
+    point = read_vector3(point_W, "point_W");
+  } else if (const auto f = frame_not_body(r.model(), body)) {
+    // A frame's name (a merged link, a tool frame): the frame's origin, not its body's.
+    point = frame_pose(r.model(), *r.data, *f).translation;
+  } else {
+    return to_numpy(body_jacobian(r.model(), *r.data, b));
+  }
+  point_jacobian(r.model(), *r.data, b, point, r.data->J);
   return to_numpy(r.data->J);
 }
 
@@ -155,7 +174,7 @@ q, dq, ddq: (n,). wrenches: ExternalWrench or a list of them (world frame). Retu
         py::arg("point_W") = py::none(),
         R"(Jacobian (6, n) = [J_v; J_w] of a point rigidly attached to `body` (index or name).
 
-point_W: (3,) the point in W (default: the body frame's origin). J_v gives the point's linear
+point_W: (3,) the point in W (default: the origin of the body, or of the frame named). J_v gives the point's linear
 velocity, J_w the body's angular velocity, both in world-aligned axes.)");
   m.def("forward_kinematics", &forward_kinematics_py, py::arg("robot"), py::arg("q"),
         "Poses X_WB of every body, (n + 1, 4, 4) homogeneous transforms (body 0 = link 0).");

@@ -30,10 +30,15 @@ int Robot::body(const py::handle& body_or_name, const char* argument) const {
     if (const auto b = m.find_body(name)) return *b;
     throw py::value_error(std::string(argument) + ": no body or frame named '" + name + "'");
   }
-  if (!py::isinstance<py::int_>(body_or_name) || py::isinstance<py::bool_>(body_or_name)) {
-    throw py::type_error(std::string(argument) + ": expected a body index or name");
+  // Any integer (numpy's too: a value of an estimate's `link` column), not a bool.
+  if (!PyIndex_Check(body_or_name.ptr()) || py::isinstance<py::bool_>(body_or_name) ||
+      (py::hasattr(body_or_name, "dtype") &&
+       body_or_name.attr("dtype").attr("kind").cast<std::string>() == "b")) {
+    throw py::type_error(std::string(argument) +
+                         ": expected a body index (an integer) or name, got " +
+                         std::string(py::str(py::type::handle_of(body_or_name).attr("__name__"))));
   }
-  const auto b = body_or_name.cast<long long>();
+  const auto b = py::int_(py::reinterpret_borrow<py::object>(body_or_name)).cast<long long>();
   if (b < 0 || b >= m.num_bodies()) {
     throw py::value_error(std::string(argument) + ": body index " + std::to_string(b) +
                           " out of range [0, " + std::to_string(m.num_bodies() - 1) + "]");

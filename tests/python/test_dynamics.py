@@ -142,6 +142,44 @@ def test_other_arguments_named(robot):
         extwrench.rnea(robot, z, z, z, [1, 2])
 
 
+TWO_LINKS_AND_A_TIP = """<robot name="two">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="upper"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="lower"><inertial><mass value="1"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial></link>
+  <link name="tip"/>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="upper"/><axis xyz="0 1 0"/></joint>
+  <joint name="j2" type="continuous"><parent link="upper"/><child link="lower"/>
+    <origin xyz="0 0 0.4"/><axis xyz="1 0 0"/></joint>
+  <joint name="t" type="fixed"><parent link="lower"/><child link="tip"/>
+    <origin xyz="0.1 0.2 0.3" rpy="0.3 0 0"/></joint>
+</robot>
+"""
+
+
+def test_jacobian_of_a_frame_is_at_the_frame(tmp_path):
+    # A frame merged into its body (a tool tip): J_v is the velocity of the frame's origin,
+    # checked against finite differences of forward_kinematics, not the body origin's.
+    path = tmp_path / "two.urdf"
+    path.write_text(TWO_LINKS_AND_A_TIP)
+    robot = extwrench.load_robot(path)
+    lower = robot.bodies.index("lower")
+    q = np.array([0.4, -0.7])
+
+    def tip(q):
+        return (extwrench.forward_kinematics(robot, q)[lower] @ [0.1, 0.2, 0.3, 1.0])[:3]
+
+    h = 1e-6
+    fd = np.column_stack([(tip(q + h * e) - tip(q - h * e)) / (2 * h) for e in np.eye(2)])
+    J = extwrench.jacobian(robot, q, "tip")
+    np.testing.assert_allclose(J[:3], fd, atol=1e-8)
+    assert np.abs(J[:3] - extwrench.jacobian(robot, q, "lower")[:3]).max() > 0.1
+    # An index from an estimate's `link` column is a numpy integer.
+    assert np.array_equal(extwrench.jacobian(robot, q, np.int64(lower)),
+                          extwrench.jacobian(robot, q, lower))
+    with pytest.raises(TypeError, match="body index"):
+        extwrench.jacobian(robot, q, True)
+
+
 def test_no_reference_leak_over_many_calls(robot):
     n = robot.nq
     q, dq, ddq = np.zeros(n), np.full(n, 0.1), np.zeros(n)
