@@ -285,8 +285,19 @@ Returns an Estimate. Bad input raises ValueError naming it; the state is then un
           "The calibration file the configuration includes (`calibration:`), or None.")
       .def(
           "config_yaml",
-          [](const Estimator& e) { return to_yaml(e.config, std::filesystem::current_path()); },
-          "The configuration as YAML text (docs/config.md).")
+          [](const Estimator& e, const py::object& directory) {
+            // Without a directory the robot's path stays absolute: the text may be written
+            // anywhere, and a path relative to the working directory would not load there.
+            return to_yaml(e.config, directory.is_none()
+                                         ? std::filesystem::path()
+                                         : std::filesystem::absolute(
+                                               directory.cast<std::filesystem::path>()));
+          },
+          py::arg("directory") = py::none(),
+          R"(The configuration as YAML text (docs/config.md).
+
+directory: where the text will be written; the robot's path is then relative to it (as a
+configuration file's paths are). Default: the absolute path.)")
       .def_property_readonly("last", [](const Estimator& e) {
         return Estimate{e.estimator.result(), e.body_names};
       });

@@ -421,9 +421,11 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
   std::ostringstream y;
   y.precision(17);
   std::filesystem::path robot = config.robot_path;
-  std::error_code ec;
-  const std::filesystem::path rel = std::filesystem::relative(robot, directory, ec);
-  if (!ec && !rel.empty()) robot = rel;
+  if (!directory.empty()) {
+    std::error_code ec;
+    const std::filesystem::path rel = std::filesystem::relative(robot, directory, ec);
+    if (!ec && !rel.empty()) robot = rel;
+  }
   y << "robot: " << yaml_scalar(robot.string()) << '\n';
   if (!config.locked_joints.empty()) {
     y << "locked_joints: {";

@@ -181,6 +181,20 @@ def test_config_errors_name_the_key(robot, change, words):
     assert isinstance(info.value, ValueError)
 
 
+def test_config_yaml_loads_wherever_it_is_written(robot, log, tmp_path, monkeypatch):
+    est = extwrench.ContactEstimator(robot, CONFIG)
+    want = extwrench.estimate(est, *log)
+    monkeypatch.chdir(tmp_path)
+    for where, text in ((tmp_path / "x" / "y", est.config_yaml()),
+                        (tmp_path / "z", est.config_yaml(tmp_path / "z")),
+                        (tmp_path / "w", est.config_yaml("w"))):
+        where.mkdir(parents=True)
+        (where / "config.yaml").write_text(text)
+        got = extwrench.estimate(str(where / "config.yaml"), *log)
+        assert same(got["force_W"], want["force_W"]), where
+    assert "robot: " + str(PAPER_URDF) in est.config_yaml()
+
+
 def test_config_errors_match_the_file_loader(robot, tmp_path):
     # The dict goes through the project's loader: the same message as the file, but the name.
     path = tmp_path / "c.yaml"

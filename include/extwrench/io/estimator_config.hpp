@@ -67,7 +67,8 @@ struct EstimatorConfig {
 [[nodiscard]] ContactEstimator make_estimator(const EstimatorConfig& config);
 
 /// The options written back as a configuration file (robot path as given, made relative to
-/// `directory` when possible). Loading the result gives the same options.
+/// `directory` when possible; an empty `directory` keeps it). Loading the result gives the same
+/// options.
 [[nodiscard]] std::string to_yaml(const EstimatorConfig& config,
                                   const std::filesystem::path& directory);
 
