@@ -4,6 +4,8 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cstring>
+
 #include "arrays.hpp"
 #include "estimator.hpp"
 #include "extwrench/io/log.hpp"
@@ -39,7 +41,7 @@ Vector6 read_reading(const py::handle& obj, SensorType type) {
     if (size == 6 || (size == 3 && type != SensorType::kForceTorque)) {
       const auto* p = static_cast<const char*>(arr.data());
       for (py::ssize_t i = 0; i < size; ++i) {
-        reading[i] = *reinterpret_cast<const double*>(p + i * arr.strides(0));
+        std::memcpy(&reading[i], p + i * arr.strides(0), sizeof(double));  // may be unaligned
       }
       if (reading.allFinite()) return reading;
     }
@@ -288,10 +290,10 @@ Returns an Estimate. Bad input raises ValueError naming it; the state is then un
           [](const Estimator& e, const py::object& directory) {
             // Without a directory the robot's path stays absolute: the text may be written
             // anywhere, and a path relative to the working directory would not load there.
-            return to_yaml(e.config, directory.is_none()
-                                         ? std::filesystem::path()
-                                         : std::filesystem::absolute(
-                                               directory.cast<std::filesystem::path>()));
+            return to_yaml(
+                e.config, directory.is_none()
+                              ? std::filesystem::path()
+                              : std::filesystem::absolute(directory.cast<std::filesystem::path>()));
           },
           py::arg("directory") = py::none(),
           R"(The configuration as YAML text (docs/config.md).
