@@ -27,9 +27,16 @@ double time_update_loop(const Estimator& source, const py::handle& t, const py::
   const int n = source.nq();
   const RealArray T = real_array(t, "t", 1), Q = real_array(q, "q", 2),
                   DQ = real_array(dq, "dq", 2), TAU = real_array(tau, "tau", 2);
+  if (T.rows < 1) throw py::value_error("t: expected at least one sample");
+  check_shape(Q, "q", T.rows, n);
+  check_shape(DQ, "dq", T.rows, n);
+  check_shape(TAU, "tau", T.rows, n);
   std::vector<Sample> rows(static_cast<std::size_t>(T.rows));
   RealArray R;
-  if (!reading.is_none()) R = real_array(reading, "reading", 2);
+  if (!reading.is_none()) {
+    R = real_array(reading, "reading", 2);
+    check_shape(R, "reading", T.rows, 6);
+  }
   for (py::ssize_t k = 0; k < T.rows; ++k) {
     Sample& s = rows[static_cast<std::size_t>(k)];
     s.t = T.at(k);

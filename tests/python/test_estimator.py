@@ -2,6 +2,7 @@
 update loop against the C++ batch loop, flags, errors that leave the state untouched, leaks."""
 
 import gc
+import re
 import sys
 
 import numpy as np
@@ -342,3 +343,16 @@ def test_no_reference_leak(robot, log):
     del out, e
     gc.collect()
     assert [sys.getrefcount(x) for x in watched] == before
+
+
+def test_the_benchmark_loop_checks_its_arrays(robot):
+    # benchmarks/python_bench.py's C++ loop read past short arrays and crashed on empty ones.
+    from extwrench import _extwrench
+    est = extwrench.ContactEstimator(robot, {"sensor": {"type": "none"}})
+    t, z = np.arange(5) * 1e-3, np.zeros((5, 7))
+    for args, words in (((t[:0], z[:0], z[:0], z[:0]), "t: expected at least one sample"),
+                        ((t, z[:, :3], z, z), "q: expected shape (5, 7), got (5, 3)"),
+                        ((t, z, z[:4], z), "dq: expected shape (5, 7), got (4, 7)")):
+        with pytest.raises(ValueError, match=re.escape(words)):
+            _extwrench._time_update_loop(est, *args, None)
+    assert _extwrench._time_update_loop(est, t, z, z, z, None) >= 0.0
