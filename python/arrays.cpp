@@ -139,6 +139,10 @@ Pose read_pose(const py::handle& obj, const char* name) {
   const RealArray a = real_array(obj, name, 2);
   check_shape(a, name, 4, 4);
   check_finite(a, name);
+  if (a.at(3, 0) != 0.0 || a.at(3, 1) != 0.0 || a.at(3, 2) != 0.0 || a.at(3, 3) != 1.0) {
+    throw py::value_error(std::string(name) +
+                          ": the bottom row of a homogeneous transform must be [0, 0, 0, 1]");
+  }
   Pose X;
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) X.rotation(i, j) = a.at(i, j);

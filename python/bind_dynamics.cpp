@@ -132,7 +132,15 @@ void bind_dynamics(py::module_& m) {
       .def_readonly("body", &ExternalWrench::body)
       .def_readonly("force_W", &ExternalWrench::force_W)
       .def_readonly("point_W", &ExternalWrench::point_W)
-      .def_readonly("moment_W", &ExternalWrench::moment_W);
+      .def_readonly("moment_W", &ExternalWrench::moment_W)
+      .def("__repr__", [](const ExternalWrench& w) {
+        const auto v = [](const Vector3& x) {
+          return std::string(py::str(py::make_tuple(x[0], x[1], x[2])));
+        };
+        return "<extwrench.ExternalWrench body=" + std::to_string(w.body) +
+               " force_W=" + v(w.force_W) + " point_W=" + v(w.point_W) +
+               " moment_W=" + v(w.moment_W) + ">";
+      });
 
   m.def("rnea", &rnea_py, py::arg("robot"), py::arg("q"), py::arg("dq"), py::arg("ddq"),
         py::arg("wrenches") = py::none(),

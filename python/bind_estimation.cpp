@@ -197,7 +197,8 @@ void bind_estimate(py::module_& m) {
           "sigma_point", [](const Estimate& e) { return e.value.sigma_point; },
           "1-sigma of the surface point [m].")
       .def_property_readonly(
-          "force_covariance_W", [](const Estimate& e) { return e.value.force_covariance_W; },
+          "force_covariance_W",
+          [](const Estimate& e) { return to_numpy(e.value.force_covariance_W); },
           "(3, 3) covariance of force_W [N^2].")
       .def_property_readonly(
           "moment_W", [](const Estimate& e) { return e.value.moment_W; },
@@ -244,6 +245,13 @@ ContactEstimator(robot, config): config is a dict of the configuration schema (d
 'robot' is then taken from `robot`) or the path of a configuration file (robot may be None).
 Unknown keys and bad values raise extwrench.Error with the loader's message.)")
       .def(py::init(&make), py::arg("robot"), py::arg("config"))
+      .def("__repr__",
+           [](const Estimator& e) {
+             return "<extwrench.ContactEstimator nq=" + std::to_string(e.nq()) +
+                    " sensor=" + std::string(to_string(e.config.options.sensor.type)) +
+                    " contact=" + std::string(to_string(e.config.options.contact.model)) +
+                    " robot='" + e.config.robot_path.string() + "'>";
+           })
       .def("reset", &reset, py::arg("t"), py::arg("q"), py::arg("dq"), py::arg("tau"),
            "Starts at time t [s]; q, dq, tau: (n,). tau is held over the first interval.")
       .def("update", &update, py::arg("t"), py::arg("q"), py::arg("dq"), py::arg("tau"),
@@ -252,8 +260,19 @@ Unknown keys and bad values raise extwrench.Error with the loader's message.)")
 [f; n] (6,) or f (3,) in the sensor frame, moment about its origin (None without a sensor).
 Returns an Estimate. Bad input raises ValueError naming it; the state is then unchanged.)")
       .def(
-          "request_tare", [](Estimator& e, int samples) { e.estimator.request_tare(samples); },
-          py::arg("samples"))
+          "request_tare",
+          [](Estimator& e, int samples) {
+            if (samples < 0) {
+              throw py::value_error(
+                  "request_tare: samples must be >= 0 (0 cancels a pending "
+                  "tare), got " +
+                  std::to_string(samples));
+            }
+            e.estimator.request_tare(samples);
+          },
+          py::arg("samples"),
+          "Re-estimates the base sensor's bias over the next `samples` updates, which must be "
+          "free of contact (docs/estimator.md); 0 cancels a pending tare.")
       .def(
           "warm_up", [](const Estimator& e) { e.estimator.warm_up(); },
           "Pages in what the first contact needs (the ray casting against the collision shapes); "

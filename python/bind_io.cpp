@@ -4,6 +4,9 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <charconv>
+#include <string_view>
+
 #include "arrays.hpp"
 #include "estimator.hpp"
 #include "extwrench/io/log.hpp"
@@ -103,21 +106,44 @@ RealArray column(const py::dict& d, const char* dict_name, const char* key, py::
 Vector3 row3(const RealArray& a, py::ssize_t k) { return {a.at(k, 0), a.at(k, 1), a.at(k, 2)}; }
 
 /// The Status of a status text of estimates.csv ("non_finite:q[2]"); ok for a flags text.
-Status parse_status(const std::string& text) {
+/// ValueError naming row `row` for a code, channel or index this version does not write.
+Status parse_status(const std::string& text, py::ssize_t row) {
   const auto colon = text.find(':');
   if (colon == std::string::npos) return {};
+  const auto bad = [&](const std::string& what) {
+    return py::value_error("estimates['status'][" + std::to_string(row) + "]: '" + text +
+                           "': " + what +
+                           " (estimates.csv writes CODE:CHANNEL or CODE:CHANNEL[INDEX], "
+                           "docs/log_format.md)");
+  };
   Status s;
+  bool code_known = false;
   for (int c = 1; c <= static_cast<int>(StatusCode::kSingular); ++c) {
-    if (to_string(static_cast<StatusCode>(c)) == text.substr(0, colon))
+    if (to_string(static_cast<StatusCode>(c)) == text.substr(0, colon)) {
       s.code = static_cast<StatusCode>(c);
+      code_known = true;
+    }
   }
+  if (!code_known) throw bad("unknown code '" + text.substr(0, colon) + "'");
   const auto bracket = text.find('[', colon);
   const std::string channel = text.substr(
       colon + 1, bracket == std::string::npos ? std::string::npos : bracket - colon - 1);
+  bool channel_known = false;
   for (int c = 0; c <= static_cast<int>(Channel::kBaseWrench); ++c) {
-    if (to_string(static_cast<Channel>(c)) == channel) s.channel = static_cast<Channel>(c);
+    if (to_string(static_cast<Channel>(c)) == channel) {
+      s.channel = static_cast<Channel>(c);
+      channel_known = true;
+    }
   }
-  if (bracket != std::string::npos) s.index = std::stoi(text.substr(bracket + 1));
+  if (!channel_known) throw bad("unknown channel '" + channel + "'");
+  if (bracket != std::string::npos) {
+    const std::string index = text.substr(bracket + 1);
+    int value = -1;
+    const auto [end, ec] = std::from_chars(index.data(), index.data() + index.size(), value);
+    if (ec != std::errc() || value < 0 || std::string_view(end) != "]")
+      throw bad("the index is not a count in brackets");
+    s.index = value;
+  }
   return s;
 }
 
@@ -186,7 +212,7 @@ struct EstimateRows {
     e.sigma_moment = sigma_at(1);
     e.sigma_line = sigma_at(2);
     e.sigma_point = sigma_at(3);
-    e.status = status.empty() ? Status{} : parse_status(status[static_cast<std::size_t>(k)]);
+    e.status = status.empty() ? Status{} : parse_status(status[static_cast<std::size_t>(k)], k);
   }
 };
 
@@ -213,6 +239,21 @@ py::dict stat(const sim::ErrorStat& s) {
 
 py::dict metrics_py(const py::dict& truth, const py::dict& estimates, double from, double to,
                     const std::vector<std::pair<double, double>>& exclude) {
+  // As `extwrench estimate` checks --metrics-from, --metrics-to and --exclude: NaN would count
+  // every sample, and an interval with from >= to would exclude none, both without a word.
+  if (std::isnan(from) || std::isnan(to) || !(from < to)) {
+    throw py::value_error("start, stop: expected times in seconds with start < stop, got " +
+                          std::string(py::str(py::float_(from))) + ", " +
+                          std::string(py::str(py::float_(to))));
+  }
+  for (std::size_t i = 0; i < exclude.size(); ++i) {
+    if (!(exclude[i].first < exclude[i].second)) {
+      throw py::value_error("exclude[" + std::to_string(i) +
+                            "]: expected (from, to) in seconds with from < to, got (" +
+                            std::string(py::str(py::float_(exclude[i].first))) + ", " +
+                            std::string(py::str(py::float_(exclude[i].second))) + ")");
+    }
+  }
   const RealArray t = column(truth, "truth", "t", -1, -1);
   const RealArray body = column(truth, "truth", "true_body", t.rows, -1);
   const RealArray contacts = column(truth, "truth", "true_contacts", t.rows, -1);

@@ -15,8 +15,10 @@ namespace extwrench::python {
 Robot::Robot(RobotDescription d, LoadOptions o)
     : description(std::move(d)),
       options(std::move(o)),
-      absolute_source(description.source.empty() ? std::filesystem::path()
-                                                 : std::filesystem::absolute(description.source)),
+      absolute_source(
+          description.source.empty()
+              ? std::filesystem::path()
+              : std::filesystem::weakly_canonical(std::filesystem::absolute(description.source))),
       data(std::make_unique<Data>(description.model)),
       q(VectorX::Zero(description.model.nq())),
       dq(q),

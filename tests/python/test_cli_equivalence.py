@@ -4,6 +4,7 @@ files."""
 
 import csv
 import json
+import re
 import subprocess
 
 import numpy as np
@@ -89,6 +90,14 @@ def test_metrics_equal_metrics_json(paper_run, cli_estimates):
         for stat in ("rms", "max"):
             w = window[key][stat]
             assert (np.isnan(m[key][stat]) and w is None) or m[key][stat] == w, (key, stat)
+    # A window that would count every sample or exclude nothing without a word is refused, as
+    # the CLI refuses --metrics-from nan and --exclude 2:1.
+    for window, words in (({"start": float("nan")}, "start < stop, got nan, inf"),
+                          ({"start": 2.0, "stop": 1.0}, "start < stop, got 2.0, 1.0"),
+                          ({"exclude": [(0.5, 0.6), (2.0, 1.0)]},
+                           "exclude[1]: expected (from, to) in seconds with from < to, got (2.0, 1.0)")):
+        with pytest.raises(ValueError, match=re.escape(words)):
+            extwrench.metrics(log, got, **window)
 
 
 def test_read_log_matches_the_csv(paper_run, robot):

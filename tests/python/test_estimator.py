@@ -356,3 +356,41 @@ def test_the_benchmark_loop_checks_its_arrays(robot):
         with pytest.raises(ValueError, match=re.escape(words)):
             _extwrench._time_update_loop(est, *args, None)
     assert _extwrench._time_update_loop(est, t, z, z, z, None) >= 0.0
+
+
+def test_write_estimates_reads_back_statuses_and_refuses_unknown_ones(robot, tmp_path):
+    est = extwrench.ContactEstimator(robot, {"sensor": {"type": "none"}})
+    t, z = np.arange(5) * 1e-3, np.zeros((5, 7))
+    out = extwrench.estimate(est, t, z, z, z)
+    out["status"] = list(out["status"])
+    out["status"][2] = "non_finite:q[1]"
+    extwrench.write_estimates(tmp_path / "e.csv", est, out)
+    assert ",non_finite:q[1]," in (tmp_path / "e.csv").read_text().splitlines()[3]
+    for bad, words in (("non_finite:q[x]", "the index is not a count in brackets"),
+                       ("bogus:q[1]", "unknown code 'bogus'"),
+                       ("non_finite:zz", "unknown channel 'zz'")):
+        out["status"][2] = bad
+        with pytest.raises(ValueError, match=re.escape("estimates['status'][2]: '%s': %s"
+                                                       % (bad, words))):
+            extwrench.write_estimates(tmp_path / "e.csv", est, out)
+
+
+def test_small_argument_checks_and_reprs(robot):
+    est = extwrench.ContactEstimator(robot, CONFIG)
+    assert repr(est).startswith("<extwrench.ContactEstimator nq=7 sensor=ft contact=pure_force")
+    w = extwrench.ExternalWrench(6, [20, 0, 0], [0, 0, 0.5])
+    assert repr(w) == ("<extwrench.ExternalWrench body=6 force_W=(20.0, 0.0, 0.0) "
+                       "point_W=(0.0, 0.0, 0.5) moment_W=(0.0, 0.0, 0.0)>")
+    with pytest.raises(ValueError, match="samples must be >= 0"):
+        est.request_tare(-1)  # once silently cancelled a pending tare
+    z = np.zeros(7)
+    est.reset(0.0, z, z, extwrench.gravity(robot, z))
+    reading = extwrench.sensor_reading(robot, z, z, z, X_WS=np.array(
+        [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, -0.31], [0, 0, 0, 1]], dtype=float))
+    e = est.update(1e-3, z, z, extwrench.gravity(robot, z), reading)
+    assert e.force_covariance_W.flags.c_contiguous and e.force_covariance_W.shape == (3, 3)
+    skewed = np.eye(4)
+    skewed[3, 0] = 1.0
+    with pytest.raises(ValueError, match=re.escape("X_WS: the bottom row of a homogeneous "
+                                                   "transform must be [0, 0, 0, 1]")):
+        extwrench.sensor_reading(robot, z, z, z, X_WS=skewed)
