@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cstdint>
 #include <map>
 #include <string>
 
@@ -97,8 +98,13 @@ py::dict shape_dict(const CollisionShape& s) {
   d["scale"] = Vector3(s.scale);
   if (s.mesh) {
     d["mesh_path"] = s.mesh->path;
-    d["vertices"] = Eigen::MatrixXd(s.mesh->vertices.transpose());
-    d["triangles"] = Eigen::MatrixXi(s.mesh->triangles.transpose());
+    d["vertices"] = to_numpy(s.mesh->vertices.transpose());  // (V, 3), C order as documented
+    // (T, 3) vertex indices as numpy's default integer (int64), C order.
+    py::array_t<std::int64_t> triangles({s.mesh->triangles.cols(), Eigen::Index{3}});
+    auto t = triangles.mutable_unchecked<2>();
+    for (Eigen::Index k = 0; k < s.mesh->triangles.cols(); ++k)
+      for (Eigen::Index j = 0; j < 3; ++j) t(k, j) = s.mesh->triangles(j, k);
+    d["triangles"] = triangles;
   }
   return d;
 }

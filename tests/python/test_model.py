@@ -64,6 +64,10 @@ def test_package_path(tmp_path):
     (shape,) = r.shapes
     assert shape["type"] == "mesh" and shape["triangles"].shape == (1, 3)
     assert shape["vertices"].shape == (3, 3)
+    # Rows are vertices and triangles (C order, as docs/python.md says of every result).
+    assert shape["vertices"].flags.c_contiguous and shape["triangles"].dtype == np.int64
+    assert sorted(map(tuple, shape["vertices"][shape["triangles"][0]].tolist())) == [
+        (0, 0, 0), (0, 1, 0), (1, 0, 0)]
     with pytest.raises(extwrench.Error, match="mybot"):
         extwrench.load_robot(urdf, use_ros_package_path=False)
 
