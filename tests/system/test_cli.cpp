@@ -176,7 +176,17 @@ TEST_F(Cli, NoArgumentsPrintsTheHelpAndFails) {
 }
 
 TEST_F(Cli, UnknownCommandsAndOptionsAreUsageErrors) {
-  EXPECT_EQ(run("frobnicate").code, kExitUsageError);
+  // The word typed is named (CLI11 said only "A subcommand is required"), a near miss suggested.
+  const RunResult unknown = run("frobnicate");
+  EXPECT_EQ(unknown.code, kExitUsageError);
+  EXPECT_TRUE(contains(unknown.err, "unknown command 'frobnicate'. The commands are info, "
+                                    "dynamics, estimate, simulate, calibrate."));
+  const RunResult typo = run("estimat --config c.yaml");
+  EXPECT_EQ(typo.code, kExitUsageError);
+  EXPECT_TRUE(contains(typo.err, "unknown command 'estimat'; did you mean 'estimate'?"));
+  const RunResult help = run("help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_TRUE(contains(help.out, "Subcommands:"));
   const RunResult r = run("info --no-such-option " + kModels.string() + "/paper_arm.urdf");
   EXPECT_EQ(r.code, kExitUsageError);
   EXPECT_TRUE(contains(r.err, "--no-such-option"));
