@@ -47,7 +47,8 @@ void run_calibrate(const CalibrateOptions& opt) {
   load.package_path = opt.package_path;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   const auto start = std::chrono::steady_clock::now();
-  const CalibrateLogResult run = calibrate_log(config, opt.log, co, opt.arguments.holdout);
+  const CalibrateLogResult run =
+      calibrate_log(config, opt.log, co, opt.arguments.holdout, opt.arguments.ignore_extra_joints);
   const Calibration& cal = run.calibration;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -113,6 +114,9 @@ void register_calibrate(CLI::App& app) {
                 "correction), kept where it lowers the joint's residual by 10 % or more beyond "
                 "the velocity's noise and a gravity error; best with observer.velocity_cutoff on "
                 "joints whose dq is noisy");
+  sub->add_flag("--ignore-extra-joints", opt->arguments.ignore_extra_joints,
+                "Ignore joint columns beyond the robot's n (q8, tau8 of a gripper on a 7-joint "
+                "arm); without it they are an error, as for estimate");
   add_package_path_option(*sub, opt->package_path);
   sub->footer(help_footer(
       {{"extwrench calibrate --config panda.yaml --log free.csv --out calib.yaml --holdout 0.4",

@@ -129,7 +129,7 @@ py::dict calibrate_py(const Estimator& estimator, const std::filesystem::path& l
                       const std::string& sign, double smoothing_velocity,
                       double presliding_displacement, double false_alarms_per_hour,
                       const std::string& thresholds, bool payload, bool known_torque, bool inertia,
-                      const std::optional<std::filesystem::path>& out) {
+                      bool ignore_extra_joints, const std::optional<std::filesystem::path>& out) {
   CalibrateArguments arguments;
   arguments.holdout = holdout;
   arguments.sign = sign;
@@ -145,7 +145,7 @@ py::dict calibrate_py(const Estimator& estimator, const std::filesystem::path& l
   std::string yaml;
   {
     py::gil_scoped_release release;
-    run = calibrate_log(estimator.config, log, options, holdout);
+    run = calibrate_log(estimator.config, log, options, holdout, ignore_extra_joints);
     yaml = calibration_yaml(run);
   }
   if (out) write_calibration(*out, yaml);
@@ -202,7 +202,8 @@ void bind_app(py::module_& m) {
         py::arg("holdout") = 0.0, py::arg("sign") = "tanh", py::arg("smoothing_velocity") = 0.0,
         py::arg("presliding_displacement") = 0.0, py::arg("false_alarms_per_hour") = 1.0,
         py::arg("thresholds") = "auto", py::arg("payload") = false, py::arg("known_torque") = false,
-        py::arg("inertia") = false, py::arg("out") = py::none(),
+        py::arg("inertia") = false, py::arg("ignore_extra_joints") = false,
+        py::arg("out") = py::none(),
         R"(Calibrates the estimator's configuration from a contact-free log, as `extwrench
 calibrate --config CONFIG --log LOG` does (docs/calibration.md): friction, torque offsets, sensor
 bias, residual noise and thresholds, fitted on the first (1 - holdout) of the log's rows and,

@@ -159,7 +159,8 @@ def calibrate(estimator: ContactEstimator, log: PathLike, *, holdout: float = ..
               sign: str = ..., smoothing_velocity: float = ...,
               presliding_displacement: float = ..., false_alarms_per_hour: float = ...,
               thresholds: str = ..., payload: bool = ..., known_torque: bool = ...,
-              inertia: bool = ..., out: Optional[PathLike] = ...) -> Dict[str, Any]: ...
+              inertia: bool = ..., ignore_extra_joints: bool = ...,
+              out: Optional[PathLike] = ...) -> Dict[str, Any]: ...
 def _estimate(estimator: ContactEstimator, t: ArrayLike, q: ArrayLike, dq: Optional[ArrayLike],
               tau: ArrayLike, reading: Optional[ArrayLike] = ...) -> Dict[str, Any]: ...
 def _contact_summary(estimator: ContactEstimator, t: ArrayLike, contact: ArrayLike,

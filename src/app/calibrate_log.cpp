@@ -1,8 +1,10 @@
 #include "extwrench/app/calibrate_log.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -13,6 +15,7 @@
 #include "extwrench/io/log.hpp"
 #include "extwrench/io/number_text.hpp"
 #include "extwrench/io/output_files.hpp"
+#include "log_columns.hpp"
 
 namespace extwrench {
 namespace {
@@ -66,8 +69,41 @@ CalibrationOptions calibration_options(const CalibrateArguments& a, const Argume
   return o;
 }
 
+namespace {
+
+// A log that says itself it is in contact (true_link, a simulation's or a force plate's): more
+// than the share of contact calibrate() tolerates is refused here, since a contact over most of
+// the log escapes calibrate()'s own detection; less is returned as a warning.
+std::optional<std::string> truth_contact_note(const std::vector<Sample>& fit,
+                                              const CalibrationOptions& options,
+                                              const std::filesystem::path& log) {
+  std::size_t contact = 0;
+  double first = 0.0, last = 0.0;
+  for (const Sample& s : fit) {
+    if (!s.has_truth || s.truth.body < 0) continue;
+    if (contact++ == 0) first = s.t;
+    last = s.t;
+  }
+  if (contact == 0) return std::nullopt;
+  const double share = static_cast<double>(contact) / static_cast<double>(fit.size());
+  const std::string what = "its truth column true_link marks a contact on " +
+                           format_number(std::round(1000.0 * share) / 10.0) +
+                           " % of the fitted rows (between t = " + format_number(first) + " and " +
+                           format_number(last) + " s)";
+  if (share > options.max_contact_fraction) {
+    throw Error(log.string() + ": " + what + ": calibration needs a contact-free log (at most " +
+                format_number(100.0 * options.max_contact_fraction) +
+                " % in contact), or the external torque known during the recording in its "
+                "true_tau_ext1..n columns (--known-torque; Python: known_torque=True)");
+  }
+  return what + ": the fit treats them as free motion unless its own detection excludes them";
+}
+
+}  // namespace
+
 CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::filesystem::path& log,
-                                 const CalibrationOptions& options, double holdout) {
+                                 const CalibrationOptions& options, double holdout,
+                                 bool ignore_extra_joint_columns) {
   if (!(holdout >= 0.0 && holdout < 1.0))
     throw Error("holdout: expected a fraction in [0, 1), got " + format_number(holdout));
   check_input_file(log, "log");
@@ -75,6 +111,8 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
   std::vector<Sample> samples;
   {
     LogReader reader(log, model);
+    detail::check_joint_columns(reader, model.nq(), ignore_extra_joint_columns);
+    detail::check_sensor_columns(reader, config.options.sensor.type);
     for (Sample s; reader.next(s);) samples.push_back(s);
   }
   CalibrateLogResult result;
@@ -82,11 +120,15 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
   result.fit_rows = static_cast<std::size_t>(static_cast<double>(samples.size()) * (1.0 - holdout));
   const std::vector<Sample> fit(samples.begin(),
                                 samples.begin() + static_cast<std::ptrdiff_t>(result.fit_rows));
+  const std::optional<std::string> truth_note =
+      options.known_external_torque ? std::nullopt : truth_contact_note(fit, options, log);
   try {
     result.calibration = calibrate(model, config.options, fit, options);
   } catch (const Error& e) {
     throw Error(log.string() + ": " + e.what());
   }
+  if (truth_note)
+    result.calibration.warnings.insert(result.calibration.warnings.begin(), *truth_note);
   result.calibration.source = log.string();
   if (holdout > 0)
     result.holdout =

@@ -13,6 +13,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/log.hpp"
 #include "figures.hpp"
+#include "log_columns.hpp"
 #include "pipeline.hpp"
 #include "progress.hpp"
 
@@ -38,49 +39,6 @@ void note_ignored_columns(const LogReader& reader, std::ostream& messages) {
   if (ignored.size() > kShown) list += " and " + std::to_string(ignored.size() - kShown) + " more";
   messages << "extwrench: note: " << reader.name()
            << ": ignoring columns not in the log format: " << list << "\n";
-}
-
-// "q8", "dq8", "tau8", "true_tau_ext8" with 8 > n: a log of another robot, or of this one with
-// a gripper joint; either way the user should say so.
-bool beyond_joints(const std::string& column, int n) {
-  for (const char* prefix : {"true_tau_ext", "tau", "dq", "q"}) {
-    const std::string p = prefix;
-    if (column.size() <= p.size() || column.compare(0, p.size(), p) != 0) continue;
-    const std::string digits = column.substr(p.size());
-    if (digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos)
-      return false;
-    return std::stoi(digits) > n;
-  }
-  return false;
-}
-
-void check_joint_columns(const LogReader& reader, int n, bool ignore) {
-  if (ignore) return;
-  std::string list;
-  int count = 0;
-  for (const std::string& c : reader.ignored_columns()) {
-    if (!beyond_joints(c, n)) continue;
-    if (++count <= 8) list += (list.empty() ? "" : ", ") + c;
-  }
-  if (count == 0) return;
-  if (count > 8) list += " and " + std::to_string(count - 8) + " more";
-  throw Error(reader.name() + ":1: columns " + list + " are beyond the robot's " +
-              std::to_string(n) +
-              " joints: is this the log of another robot (or of extra joints such as a "
-              "gripper's)? Pass --ignore-extra-joints to ignore them on purpose");
-}
-
-void check_sensor_columns(const LogReader& reader, SensorType sensor) {
-  const LogLayout& layout = reader.layout();
-  if (sensor == SensorType::kForceTorque && !(layout.force && layout.moment)) {
-    throw Error(reader.name() + ":1: the configuration's sensor.type is 'ft' but the log has no " +
-                (layout.force ? "ms_x, ms_y, ms_z" : "fs_x..fs_z, ms_x..ms_z") + " columns");
-  }
-  if (sensor == SensorType::kForce && !layout.force) {
-    throw Error(reader.name() +
-                ":1: the configuration's sensor.type is 'force' but the log has no fs_x, fs_y, "
-                "fs_z columns");
-  }
 }
 
 /// The estimate of each row. The first row (and each next one while the reset fails) resets the
@@ -187,9 +145,9 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
                         const EstimatorOptions& estimator_options, const ReplayOptions& o) {
   LogReader reader(o.log, model);
   const LogLayout layout = reader.layout();  // a copy: the reader moves to its thread
-  check_joint_columns(reader, model.nq(), o.ignore_extra_joint_columns);
+  detail::check_joint_columns(reader, model.nq(), o.ignore_extra_joint_columns);
   if (o.warn_ignored_columns) note_ignored_columns(reader, messages_of(o));
-  check_sensor_columns(reader, estimator_options.sensor.type);
+  detail::check_sensor_columns(reader, estimator_options.sensor.type);
   OutputFiles own_outputs;
   OutputFiles& outputs = o.outputs != nullptr ? *o.outputs : own_outputs;
   outputs.create_directories(o.out_dir);

@@ -357,6 +357,37 @@ TEST_F(Hostile, AnOutputThatIsNotAPlainFileIsRefusedAndLeftAlone) {
   EXPECT_FALSE(fs::exists(path("-")));
 }
 
+TEST_F(Hostile, CalibrateChecksTheLogsHeaderAsEstimateDoes) {
+  // A log with an eighth joint's columns, and one without the F/T sensor's columns, for a
+  // 7-joint arm configured with an F/T sensor: calibrate once read the first silently and said
+  // only "no usable base-sensor sample" of the second.
+  write_log(path("log.csv"), 2'000);
+  const std::string log = read_text(path("log.csv"));
+  std::string eight;
+  std::istringstream lines(log);
+  for (std::string line; std::getline(lines, line);)
+    eight += line + (eight.empty() ? ",q8,tau8\n" : ",0,0\n");
+  write_text(path("eight.csv"), eight);
+  write_text(path("no_sensor.csv"), test::drop_columns(log, {"fs_", "ms_"}));
+  write_text(path("config.yaml"), "robot: " + kPaperArm.string() + "\nsensor: {type: ft}\n");
+  const std::string calibrate = "calibrate --config " + q(path("config.yaml")) + " --out " +
+                                q(path("calib.yaml")) + " --log ";
+  const CliRun extra = run(calibrate + q(path("eight.csv")));
+  EXPECT_EQ(extra.code, 1);
+  EXPECT_TRUE(contains(extra.err, "eight.csv:1: columns q8, tau8 are beyond the robot's 7 joints"));
+  const CliRun missing = run(calibrate + q(path("no_sensor.csv")));
+  EXPECT_EQ(missing.code, 1);
+  EXPECT_TRUE(contains(missing.err,
+                       "no_sensor.csv:1: the configuration's sensor.type is 'ft' but "
+                       "the log has no fs_x..fs_z, ms_x..ms_z columns"));
+  EXPECT_FALSE(fs::exists(path("calib.yaml")));
+  // On purpose: the eighth joint's columns are ignored, and the fit goes on to its own verdict
+  // on this motionless log.
+  const CliRun ignored = run(calibrate + q(path("eight.csv")) + " --ignore-extra-joints");
+  EXPECT_FALSE(contains(ignored.err, "beyond the robot's")) << ignored.err;
+  EXPECT_TRUE(contains(ignored.err, "not excited")) << ignored.err;
+}
+
 TEST_F(Hostile, ANonNumericMetricsWindowNamesItsOwnOption) {
   // NaN compares false with everything: the message once said the other bound was out of order.
   const std::string estimate = "estimate --config c.yaml --log l.csv --out o ";

@@ -442,10 +442,10 @@ TEST_F(RealLog, TheMetricsWindowIsSaidAndAnEmptyOneIsWarnedAbout) {
 }
 
 // What `calibrate` says of the paper's log, whose push is held from t = 0 (not contact-free, as a
-// newcomer may try): the 2.5 s run is refused with numbers as people write them; on the whole
-// 6 s it warns, and its model check does not read joint 1's residual against the model's gravity
-// torque about a vertical axis, which is rounding (once "-4.1e+14 times the model's own gravity
-// torque on it", R^2 0.5).
+// newcomer may try): the 2.5 s run is refused with numbers as people write them; the whole 6 s
+// is refused while its truth columns say it is in contact, and without them it warns, and its model
+// check does not read joint 1's residual against the model's gravity torque about a vertical axis,
+// which is rounding (once "-4.1e+14 times the model's own gravity torque on it", R^2 0.5).
 TEST_F(RealLog, CalibrateOnThePushedLogSaysWhatAPersonCanRead) {
   const CliRun short_log = run("calibrate --config '" + config("short_cal", "").string() +
                                "' --log '" + (dir_ / "robot_log.csv").string() + "' --out '" +
@@ -462,8 +462,22 @@ TEST_F(RealLog, CalibrateOnThePushedLogSaysWhatAPersonCanRead) {
   const CliRun sim = run("simulate --no-figures '" + (dir_ / "paper_6s.yaml").string() +
                          "' --out '" + (dir_ / "sim_6s").string() + "'");
   ASSERT_EQ(sim.code, 0) << sim.err;
+  // The simulated log says itself that it is pushed throughout (true_link): refused, and why.
+  const CliRun told = run("calibrate --config '" + (dir_ / "sim_6s/ft/config.yaml").string() +
+                          "' --log '" + (dir_ / "sim_6s/log.csv").string() + "' --out '" +
+                          (dir_ / "sim_6s/calib.yaml").string() + "'");
+  EXPECT_EQ(told.code, 1);
+  EXPECT_TRUE(contains(told.err,
+                       "log.csv: its truth column true_link marks a contact on 100 % of "
+                       "the fitted rows (between t = 0 and 6 s): calibration needs a "
+                       "contact-free log (at most 20 % in contact)"))
+      << told.err;
+  EXPECT_FALSE(fs::exists(dir_ / "sim_6s/calib.yaml"));
+  // A robot's own log has no truth columns: then the fit runs and warns.
+  write_text(dir_ / "sim_6s/robot_log.csv",
+             test::drop_columns(read_text(dir_ / "sim_6s/log.csv"), {"true_"}));
   const CliRun cal = run("calibrate --config '" + (dir_ / "sim_6s/ft/config.yaml").string() +
-                         "' --log '" + (dir_ / "sim_6s/log.csv").string() + "' --out '" +
+                         "' --log '" + (dir_ / "sim_6s/robot_log.csv").string() + "' --out '" +
                          (dir_ / "sim_6s/calib.yaml").string() + "'");
   ASSERT_EQ(cal.code, 0) << cal.err;
   EXPECT_TRUE(contains(cal.out, "model check:")) << cal.out;
@@ -509,6 +523,38 @@ TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
     EXPECT_NEAR(f.viscous[i], truth->viscous[i], 0.05 * truth->viscous[i]) << "joint " << i + 1;
     EXPECT_NEAR(f.coulomb[i], truth->coulomb[i], 0.05 * truth->coulomb[i]) << "joint " << i + 1;
   }
+  // The same log with its truth column marking a contact on link3 for 1 s of the 12 s fitted:
+  // calibrated, with a warning that names the share and the times.
+  {
+    std::istringstream in(read_text(dir / "free/log.csv"));
+    std::string header, line, marked;
+    std::getline(in, header);
+    marked = header + "\n";
+    std::vector<std::string> names;
+    for (std::istringstream h(header); std::getline(h, line, ',');) names.push_back(line);
+    const auto column = static_cast<std::size_t>(
+        std::find(names.begin(), names.end(), "true_link") - names.begin());
+    ASSERT_LT(column, names.size());
+    for (int row = 0; std::getline(in, line); ++row) {
+      std::vector<std::string> cells;
+      for (std::istringstream c(line + ","); std::getline(c, header, ',');) cells.push_back(header);
+      if (row >= 2000 && row < 3000) {
+        for (std::size_t k = 0; k < names.size(); ++k)
+          if (names[k].rfind("true_", 0) == 0 && cells[k].empty()) cells[k] = "0";
+        cells[column] = "link3";
+      }
+      for (std::size_t k = 0; k < cells.size(); ++k) marked += (k ? "," : "") + cells[k];
+      marked += "\n";
+    }
+    write_text(dir / "free/marked_log.csv", marked);
+  }
+  const CliRun marked =
+      cli("calibrate --config free/ft/config.yaml --log free/marked_log.csv --out "
+          "free/marked.yaml --holdout 0.4");
+  ASSERT_EQ(marked.code, 0) << marked.err;
+  EXPECT_TRUE(contains(marked.err, "warning: its truth column true_link marks a contact on 8.3 % "
+                                   "of the fitted rows (between t = 2 and 2.999 s)"))
+      << marked.err;
   // The same motion as a robot logs it (no truth columns) through `estimate`: the uncalibrated
   // configuration's contacts (the friction and offsets it lacks) come with the note that says to
   // calibrate; with the calibration there is neither contact nor note.

@@ -27,6 +27,7 @@ struct CalibrateArguments {
   bool payload = false;
   bool known_torque = false;
   bool inertia = false;
+  bool ignore_extra_joints = false;  ///< joint columns beyond the robot's n are not an error
 };
 
 /// How a front end spells its arguments in messages: an argument's name from its key
@@ -55,10 +56,16 @@ struct CalibrateLogResult {
 /// Reads `log` (docs/log_format.md) for the configuration's robot, calibrates (calibrate()) on
 /// the first (1 − holdout) of its rows with the configuration's options and, when holdout > 0,
 /// judges the calibration on the rest (validate_holdout()). Throws extwrench::Error naming the
-/// log (its line for a malformed row) or, for a holdout outside [0, 1), the fraction.
+/// log (its line for a malformed row) or, for a holdout outside [0, 1), the fraction. The log's
+/// header is checked as `extwrench estimate` checks it: joint columns beyond the robot's n are
+/// an error unless `ignore_extra_joint_columns`, the configured sensor's columns must be there.
+/// A log whose truth columns (true_link) mark a contact on more than
+/// CalibrationOptions::max_contact_fraction of the fitted rows is refused unless the external
+/// torque is known (known_external_torque); a smaller share is warned about.
 [[nodiscard]] CalibrateLogResult calibrate_log(const EstimatorConfig& config,
                                                const std::filesystem::path& log,
-                                               const CalibrationOptions& options, double holdout);
+                                               const CalibrationOptions& options, double holdout,
+                                               bool ignore_extra_joint_columns = false);
 
 /// The report `extwrench calibrate` prints under its first line (Python's calibrate returns it
 /// as "report"): per joint the friction, the residual's RMS before and after, the variance
