@@ -26,6 +26,9 @@ namespace {
 
 }  // namespace
 
+// Ten times the per-joint grid's largest δ (docs/calibration.md, the Dahl sign).
+constexpr double kLargestPreslidingDisplacement = 0.1;
+
 CalibrationOptions calibration_options(const CalibrateArguments& a, const ArgumentSpelling& sp) {
   const auto fail = [&](std::string_view key, const std::string& what) {
     extwrench::fail(sp, key, what);
@@ -51,8 +54,18 @@ CalibrationOptions calibration_options(const CalibrateArguments& a, const Argume
   }
   if (!dahl && a.presliding_displacement > 0)
     fail("presliding_displacement", "only with " + set_to("sign", "dahl"));
-  if (!(a.smoothing_velocity >= 0)) fail("smoothing_velocity", "expected a value >= 0");
-  if (!(a.presliding_displacement >= 0)) fail("presliding_displacement", "expected a value >= 0");
+  if (!(a.smoothing_velocity >= 0))
+    fail("smoothing_velocity", "expected a value > 0 [rad/s], or 0 to choose it per joint");
+  if (!(a.presliding_displacement >= 0))
+    fail("presliding_displacement", "expected a value > 0 [rad], or 0 to choose it per joint");
+  // Presliding is a few milliradians: a larger value is another unit (mrad, degrees).
+  if (a.presliding_displacement > kLargestPreslidingDisplacement) {
+    fail("presliding_displacement",
+         "expected a displacement in rad of at most " +
+             format_number(kLargestPreslidingDisplacement) +
+             " (presliding is 0.5 to 10 mrad: " + "0.0005 to 0.01), got " +
+             format_number(a.presliding_displacement) + ": is it in mrad or degrees?");
+  }
   if (!(a.false_alarms_per_hour > 0)) fail("false_alarms_per_hour", "expected a value > 0");
   const std::optional<ThresholdModel> thresholds = threshold_model(a.thresholds);
   if (!thresholds) {

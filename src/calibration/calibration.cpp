@@ -642,7 +642,9 @@ Calibration calibrate_with(const Model& model, const EstimatorOptions& options,
   cal.false_alarms_per_hour = o.false_alarms_per_hour;
   cal.t_begin = samples.front().t;
   cal.t_end = samples.back().t;
-  const double check_smoothing = o.smoothing_velocity > 0 ? o.smoothing_velocity : 0.01;
+  // With the Dahl sign the fixed scale is a displacement δ [rad], not a velocity.
+  const double check_smoothing =
+      o.sign != SmoothSign::kDahl && o.smoothing_velocity > 0 ? o.smoothing_velocity : 0.01;
   std::vector<JointFrictionFit> fits(static_cast<std::size_t>(n));
   // Contacts are looked for in the residual of friction alone: an inertia correction could
   // absorb a push's part that follows q̈. The final fit, on the samples kept, adds it.

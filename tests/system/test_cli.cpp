@@ -179,8 +179,9 @@ TEST_F(Cli, UnknownCommandsAndOptionsAreUsageErrors) {
   // The word typed is named (CLI11 said only "A subcommand is required"), a near miss suggested.
   const RunResult unknown = run("frobnicate");
   EXPECT_EQ(unknown.code, kExitUsageError);
-  EXPECT_TRUE(contains(unknown.err, "unknown command 'frobnicate'. The commands are info, "
-                                    "dynamics, estimate, simulate, calibrate."));
+  EXPECT_TRUE(contains(unknown.err,
+                       "unknown command 'frobnicate'. The commands are info, "
+                       "dynamics, estimate, simulate, calibrate."));
   const RunResult typo = run("estimat --config c.yaml");
   EXPECT_EQ(typo.code, kExitUsageError);
   EXPECT_TRUE(contains(typo.err, "unknown command 'estimat'; did you mean 'estimate'?"));
@@ -207,7 +208,16 @@ TEST_F(Cli, CalibrateRefusesTheOtherSignsScale) {
   }
   const RunResult negative = run(files + "--sign dahl --presliding-displacement -0.003");
   EXPECT_EQ(negative.code, kExitUsageError);
-  EXPECT_TRUE(contains(negative.err, "--presliding-displacement"));
+  EXPECT_TRUE(contains(negative.err,
+                       "--presliding-displacement: expected a value > 0 [rad], or 0 "
+                       "to choose it per joint"));
+  // 5 (mrad meant) was taken as 5 rad, and the excitation check then read it as 5 rad/s.
+  const RunResult mrad = run(files + "--sign dahl --presliding-displacement 5");
+  EXPECT_EQ(mrad.code, kExitUsageError);
+  EXPECT_TRUE(contains(mrad.err,
+                       "--presliding-displacement: expected a displacement in rad of at "
+                       "most 0.1 (presliding is 0.5 to 10 mrad: 0.0005 to 0.01), got 5: "
+                       "is it in mrad or degrees?"));
 }
 
 // ---- info --------------------------------------------------------------------------------
