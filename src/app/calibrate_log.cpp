@@ -138,7 +138,15 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
   try {
     result.calibration = calibrate(model, config.options, fit, options);
   } catch (const Error& e) {
-    throw Error(log.string() + ": " + e.what());
+    // With a holdout the fit sees only the log's first part: say so, or "record a longer
+    // motion" reads as if the whole log were too short.
+    const std::string part =
+        holdout > 0 && !fit.empty()
+            ? " (the fit has the first " + std::to_string(fit.size()) + " of the log's " +
+                  std::to_string(samples.size()) + " rows, t <= " + format_number(fit.back().t) +
+                  " s: the holdout " + format_number(holdout) + " keeps the rest for judging)"
+            : std::string();
+    throw Error(log.string() + ": " + e.what() + part);
   }
   if (truth_note)
     result.calibration.warnings.insert(result.calibration.warnings.begin(), *truth_note);

@@ -386,6 +386,13 @@ TEST_F(Hostile, CalibrateChecksTheLogsHeaderAsEstimateDoes) {
   const CliRun ignored = run(calibrate + q(path("eight.csv")) + " --ignore-extra-joints");
   EXPECT_FALSE(contains(ignored.err, "beyond the robot's")) << ignored.err;
   EXPECT_TRUE(contains(ignored.err, "not excited")) << ignored.err;
+  // A holdout that leaves the fit too little says so, not only "record a longer motion".
+  const CliRun held = run(calibrate + q(path("log.csv")) + " --holdout 0.99");
+  EXPECT_EQ(held.code, 1);
+  EXPECT_TRUE(contains(held.err,
+                       "(the fit has the first 20 of the log's 2000 rows, t <= 0.019 s: "
+                       "the holdout 0.99 keeps the rest for judging)"))
+      << held.err;
 }
 
 TEST_F(Hostile, ANonNumericMetricsWindowNamesItsOwnOption) {
