@@ -29,6 +29,21 @@
 namespace extwrench {
 namespace {
 
+// A scheme's configuration error, named at the scheme in the scenario: the configuration file it
+// refers to is one the run writes (or would write), which the user never saw, so its name and
+// line are dropped; the key path (observer.gain) is the scheme's own.
+Error scheme_error(const Scenario& s, const SchemeSpec& scheme,
+                   const std::filesystem::path& written, const Error& e) {
+  std::string what = e.what();
+  const std::string file = written.string() + ":";
+  if (what.rfind(file, 0) == 0) {
+    if (const auto colon = what.find(": ", file.size()); colon != std::string::npos)
+      what.erase(0, colon + 2);
+  }
+  return Error(s.source.string() + ":" + std::to_string(scheme.line) + ": scheme '" + scheme.name +
+               "': " + what);
+}
+
 // Every scheme checked before anything is written: its configuration as it will be written,
 // with the scenario's own robot in place of the seed's perturbed copy (same links and joints).
 void check_schemes(const Scenario& s, const std::filesystem::path& first_dir) {
@@ -39,12 +54,11 @@ void check_schemes(const Scenario& s, const std::filesystem::path& first_dir) {
     const std::string kRobot = "robot: ../model_estimator.urdf\n";
     if (const auto at = text.find(kRobot); at != std::string::npos)
       text.replace(at, kRobot.size(), "robot: " + quoted + "\n");
+    const std::filesystem::path written = first_dir / scheme.name / "config.yaml";
     try {
-      (void)load_estimator_config_string(text, first_dir / scheme.name / "config.yaml",
-                                         s.robot_options);
+      (void)load_estimator_config_string(text, written, s.robot_options);
     } catch (const Error& e) {
-      throw Error(s.source.string() + ":" + std::to_string(scheme.line) + ": scheme '" +
-                  scheme.name + "': " + e.what());
+      throw scheme_error(s, scheme, written, e);
     }
   }
 }
@@ -61,8 +75,7 @@ std::vector<EstimatorConfig> write_scheme_configs(const Scenario& s,
     try {
       configs.push_back(load_estimator_config(cfg));
     } catch (const Error& e) {
-      throw Error(s.source.string() + ":" + std::to_string(scheme.line) + ": scheme '" +
-                  scheme.name + "': " + e.what());
+      throw scheme_error(s, scheme, cfg, e);
     }
   }
   return configs;
