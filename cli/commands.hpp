@@ -34,6 +34,11 @@ void register_calibrate(CLI::App& app);
 
 // ---- helpers shared by subcommands (common.cpp) --------------------------------------------
 
+/// What a robot file option accepts (load_robot's formats), for every command's --help.
+inline constexpr const char* kRobotFileHelp =
+    "Robot file: URDF (.urdf, .xml), DH table (.yaml, .yml) or MJCF (.xml, .mjcf with root "
+    "<mujoco>, when built with MuJoCo)";
+
 /// "x y z roll pitch yaw" (metres, radians; URDF's fixed-axis rpy; spaces or commas between
 /// the six numbers) as a Pose. Throws UsageError naming `option` otherwise.
 [[nodiscard]] Pose parse_pose(const std::string& text, const std::string& option);

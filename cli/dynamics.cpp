@@ -128,9 +128,7 @@ void register_dynamics(CLI::App& app) {
                                      "Joint torques (inverse dynamics) and the predicted base "
                                      "force/torque sensor reading for each "
                                      "row of a CSV of states");
-  sub->add_option("--robot", opt->robot, "Robot file: URDF (.urdf, .xml) or DH table (.yaml, .yml)")
-      ->required()
-      ->type_name("FILE");
+  sub->add_option("--robot", opt->robot, kRobotFileHelp)->required()->type_name("FILE");
   sub->add_option("--in", opt->in,
                   "CSV with a header row and columns t, q1..qn, dq1..dqn, ddq1..ddqn [s, rad or m, "
                   "/s, /s^2], any order; other columns are ignored; '-' reads stdin")

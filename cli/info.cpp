@@ -144,11 +144,7 @@ void register_info(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("info",
                                      "Print what a robot file contains: links, joints, masses, "
                                      "frames, sensor pose, collision shapes");
-  sub->add_option("ROBOT", opt->robot,
-                  "Robot file: URDF (.urdf, .xml), DH table (.yaml, .yml) or MJCF (.xml, .mjcf "
-                  "with root <mujoco>, when built with MuJoCo)")
-      ->required()
-      ->type_name("FILE");
+  sub->add_option("ROBOT", opt->robot, kRobotFileHelp)->required()->type_name("FILE");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
   sub->add_option("--root-body", opt->root_body,
