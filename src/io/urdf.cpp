@@ -43,6 +43,8 @@ std::string shown(std::string_view text) {
   return text.size() > kMax ? out + "..." : out;
 }
 
+constexpr const char* kEmpty = ": the file is empty (or holds only white space and comments)";
+
 class UrdfParser {
  public:
   explicit UrdfParser(std::string file) : file_(std::move(file)) {}
@@ -51,10 +53,12 @@ class UrdfParser {
                          const LoadOptions& options) {
     tinyxml2::XMLDocument doc;
     if (doc.Parse(xml.c_str(), xml.size()) != tinyxml2::XML_SUCCESS) {
+      if (doc.ErrorID() == tinyxml2::XML_ERROR_EMPTY_DOCUMENT) throw Error(file_ + kEmpty);
       throw Error(file_ + ":" + std::to_string(doc.ErrorLineNum()) +
                   ": not well-formed XML: " + (doc.ErrorStr() ? doc.ErrorStr() : "unknown error"));
     }
     const XMLElement* robot = doc.RootElement();
+    if (robot == nullptr) throw Error(file_ + kEmpty);  // only a declaration or comments
     if (robot != nullptr && std::strcmp(robot->Name(), "mujoco") == 0) {
       throw Error(file_ + ":" + std::to_string(robot->GetLineNum()) +
                   ": the root element is <mujoco>: an MJCF file. MJCF needs extwrench built with "

@@ -8,6 +8,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "support/error_of.hpp"
 #include "support/text_files.hpp"
 
 namespace extwrench {
@@ -57,6 +58,33 @@ TEST(EstimatorConfig, ReadsEveryKeyOfAFullFile) {
   EXPECT_EQ(o.uncertainty.sensor_moment_sigma, Vector3::Constant(0.05));
   EXPECT_EQ(o.uncertainty.uncertain_fraction, 0.4);
   EXPECT_EQ(o.uncertainty.uncertain_sigmas, 2.0);
+}
+
+TEST(EstimatorConfig, AFileThatIsNotAMappingSaysWhatItIs) {
+  // A CSV log given as --config, or a list: once only "(top level): expected a mapping".
+  struct Case {
+    const char* text;
+    const char* expected;
+  };
+  for (const Case& c :
+       {Case{"t,q1,q2\n0,1,2\n",
+             "c.yaml:1: (top level): expected a mapping (key: value), got the "
+             "text 't,q1,q2 0,1,2'"},
+        Case{"- a\n- b\n", "c.yaml:1: (top level): expected a mapping (key: value), got a list"}}) {
+    const std::string msg =
+        test::error_of([&] { (void)load_estimator_config_string(c.text, "c.yaml"); });
+    EXPECT_NE(msg.find(c.expected), std::string::npos) << c.text << " -> " << msg;
+  }
+  // A DH table (read by the same YAML reader) that holds only a comment.
+  const std::filesystem::path empty =
+      std::filesystem::temp_directory_path() / "extwrench_empty_table.yaml";
+  test::write_text(empty, "# only a comment\n");
+  const std::string msg = test::error_of([&] { (void)load_robot(empty); });
+  std::filesystem::remove(empty);
+  EXPECT_NE(msg.find("extwrench_empty_table.yaml: (top level): expected a mapping (key: value), "
+                     "got nothing: the file is empty (or only comments)"),
+            std::string::npos)
+      << msg;
 }
 
 TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {

@@ -59,6 +59,19 @@ TEST(Urdf, InertialOriginIsConvertedToTheLinkFrame) {
   EXPECT_TRUE(std::isinf(m.joints[1].lower));
 }
 
+TEST(Urdf, AnEmptyFileIsCalledEmpty) {
+  // tinyxml2's own text was "Error=XML_ERROR_EMPTY_DOCUMENT ErrorID=13 (0xd) Line number=0".
+  for (const char* xml : {"", "  \n", "<!-- nothing -->\n"}) {
+    try {
+      (void)load_urdf_string(xml, "empty.urdf", no_meshes());
+      ADD_FAILURE() << "no error for '" << xml << "'";
+    } catch (const Error& e) {
+      EXPECT_STREQ(e.what(),
+                   "empty.urdf: the file is empty (or holds only white space and comments)");
+    }
+  }
+}
+
 TEST(Urdf, NonPhysicalInertiaPointsAtTheProductsOnlyWhenTheDiagonalIsPhysical) {
   // The inertial frame is rotated, so the link-frame tensor has other products than the file:
   // the message quotes the file's.

@@ -13,6 +13,17 @@
 namespace extwrench::io_detail {
 namespace {
 
+// What a node that should have been a mapping is, for the message: an empty file reads as null,
+// a CSV given as a configuration as one long scalar.
+std::string what_instead(const YAML::Node& node, bool top_level) {
+  if (!node.IsDefined() || node.IsNull())
+    return top_level ? "got nothing: the file is empty (or only comments)" : "got nothing";
+  if (node.IsSequence()) return "got a list";
+  constexpr std::size_t kShown = 40;
+  const std::string& text = node.Scalar();
+  return "got the text '" + text.substr(0, kShown) + (text.size() > kShown ? "..." : "") + "'";
+}
+
 std::string listed(std::initializer_list<const char*> names) {
   std::string list;
   for (const char* a : names) list += std::string(list.empty() ? "" : ", ") + a;
@@ -95,7 +106,10 @@ void YamlReader::unique_keys(const YAML::Node& map, const std::string& context) 
 void YamlReader::keys_of(
     const YAML::Node& map, const std::string& context,
     const std::function<void(const YAML::Node&, const std::string&)>& check) const {
-  if (!map.IsMap()) fail(map, context.empty() ? "(top level)" : context, "expected a mapping");
+  if (!map.IsMap()) {
+    fail(map, context.empty() ? "(top level)" : context,
+         "expected a mapping (key: value), " + what_instead(map, context.empty()));
+  }
   // YAML forbids a key twice in one mapping; yaml-cpp keeps both and map[k] reads the first, so
   // a second `detection:` appended to a file would be ignored without a word.
   std::map<std::string, YAML::Node> seen;
