@@ -44,9 +44,10 @@ std::string cell(double v, const char* format) {
 // One row per seed, the worst over the seeds, and the scenario's targets for the scheme.
 void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
                   const std::vector<SeedResult>& results) {
-  // NaN (printed '-') until a seed has the window: a scenario without a singularity window has
-  // no 'F RMS*', and its worst is not 0.
-  double worst_f = 0.0, worst_f_outside = NAN, worst_line = 0.0, worst_link = 1.0;
+  // NaN (printed '-') until a seed has a value: a scenario without a singularity window has no
+  // 'F RMS*', a push that never starts (start after the end) no force, line or link, and their
+  // worst is not 0 m or 100 %. fmax/fmin skip a seed's NaN.
+  double worst_f = NAN, worst_f_outside = NAN, worst_line = NAN, worst_link = NAN;
   for (const SeedResult& r : results) {
     for (const SchemeResult& sr : r.schemes) {
       if (sr.name != scheme.name) continue;
@@ -57,10 +58,10 @@ void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
       // The peak of cond(J of O_l) is tracked only for a singularity window's link.
       print_metrics_row(scheme.name, std::to_string(r.seed), m, b ? &b->metrics : nullptr,
                         scenario.singularity_link.empty() ? NAN : r.peak_condition);
-      worst_f = std::max(worst_f, m.force.rms());
+      worst_f = std::fmax(worst_f, m.force.rms());
       if (b) worst_f_outside = std::fmax(worst_f_outside, b->metrics.force.rms());
-      if (m.line.count > 0) worst_line = std::max(worst_line, m.line.rms());
-      worst_link = std::min(worst_link, m.isolation_accuracy());
+      worst_line = std::fmax(worst_line, m.line.rms());
+      worst_link = std::fmin(worst_link, m.isolation_accuracy());
     }
   }
   if (results.size() > 1) {
@@ -99,6 +100,17 @@ void run_simulate(const SimulateOptions& opt) {
                pose_summary(X_WS).c_str(),
                default_pose ? describe_default_sensor_pose(scenario.robot.model).c_str()
                             : "sensors.base.pose");
+  // A push that starts after the run ends is accepted (a shortened duration for a quick look),
+  // but a table without contact must not come as a surprise.
+  const auto& forces = scenario.simulation.forces;
+  for (std::size_t i = 0; i < forces.size(); ++i) {
+    if (forces[i].start > scenario.simulation.duration) {
+      std::fprintf(stderr,
+                   "extwrench simulate: note: forces[%zu] starts at t = %g s, after the run's end "
+                   "(duration %g s): it never acts\n",
+                   i, forces[i].start, scenario.simulation.duration);
+    }
+  }
   RunOptions run;
   run.figures = !opt.no_figures;
   run.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere (--jobs 1)
