@@ -191,6 +191,12 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     const std::filesystem::path json = o.out_dir / "metrics.json";
     write_metrics_json(outputs.stage(json), result.report);
     outputs.commit(json);
+  } else if (std::error_code ec; std::filesystem::is_regular_file(o.out_dir / "metrics.json", ec)) {
+    // An earlier run's, beside this run's estimates it would be read as theirs.
+    std::filesystem::remove(o.out_dir / "metrics.json", ec);
+    messages_of(o) << "extwrench: note: " << title << ": removed "
+                   << (o.out_dir / "metrics.json").string()
+                   << " of an earlier run (this log has no truth columns, so no metrics)\n";
   }
   if (o.figures) draw_figures(*figures, model, geometry, estimator_options, o, outputs, result);
   if (o.warn_disagreement) {

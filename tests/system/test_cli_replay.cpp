@@ -237,6 +237,16 @@ TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
   ASSERT_EQ(with_truth.code, 0) << with_truth.err;
   EXPECT_EQ(read_text(dir_ / "out_ft/estimates.csv"),
             read_text(dir_ / "out_ft_truth/estimates.csv"));
+  // The robot's log (no truth) into the same directory: the earlier run's metrics.json would be
+  // read as this run's, so it goes, with a note.
+  ASSERT_TRUE(fs::exists(dir_ / "out_ft_truth/metrics.json"));
+  const CliRun again = estimate(config("cfg_ft", types[0].second), "out_ft_truth", "--no-figures");
+  ASSERT_EQ(again.code, 0) << again.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out_ft_truth/metrics.json"));
+  EXPECT_TRUE(contains(again.err,
+                       "out_ft_truth/metrics.json of an earlier run (this log has no "
+                       "truth columns, so no metrics)"))
+      << again.err;
 }
 
 // A cell's number; NaN for empty or text cells ("ok", "link6").
@@ -552,8 +562,9 @@ TEST(Rehearsal, TheFreeMotionScenarioIsCalibratedThroughTheCli) {
       cli("calibrate --config free/ft/config.yaml --log free/marked_log.csv --out "
           "free/marked.yaml --holdout 0.4");
   ASSERT_EQ(marked.code, 0) << marked.err;
-  EXPECT_TRUE(contains(marked.err, "warning: its truth column true_link marks a contact on 8.3 % "
-                                   "of the fitted rows (between t = 2 and 2.999 s)"))
+  EXPECT_TRUE(contains(marked.err,
+                       "warning: its truth column true_link marks a contact on 8.3 % "
+                       "of the fitted rows (between t = 2 and 2.999 s)"))
       << marked.err;
   // The same motion as a robot logs it (no truth columns) through `estimate`: the uncalibrated
   // configuration's contacts (the friction and offsets it lacks) come with the note that says to
