@@ -31,9 +31,11 @@ bool is_mjcf(const std::filesystem::path& path) {
 // The MJCF-only options, refused for the other formats rather than silently ignored.
 void check_mjcf_only_options(const std::filesystem::path& path, const LoadOptions& options) {
   if (!options.root_body.empty() || !options.tip_body.empty()) {
-    throw Error(path.string() + ": root_body/tip_body ('" + options.root_body + "', '" +
+    throw Error(path.string() + ": a root or tip body ('" + options.root_body + "', '" +
                 options.tip_body +
-                "') apply to MJCF files only; a URDF or DH table is one robot already");
+                "') chooses the chain in an MJCF scene (--root-body, --tip-body; root_body, "
+                "tip_body in a configuration); a URDF or DH table describes one robot already: "
+                "leave them out");
   }
 }
 

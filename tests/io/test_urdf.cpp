@@ -8,6 +8,7 @@
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/io/urdf_writer.hpp"
+#include "support/error_of.hpp"
 #include "support/io_test_util.hpp"
 #include "support/random.hpp"
 
@@ -228,7 +229,13 @@ TEST(Urdf, MjcfOnlyOptionsAreRefusedNamingThem) {
     (void)load_robot(file, options);
     ADD_FAILURE() << "root_body accepted for a URDF";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find(file.string() + ": root_body/tip_body"), std::string::npos)
+    // Both spellings (the command line's, a configuration's) and what to do.
+    EXPECT_NE(std::string(e.what()).find(
+                  file.string() + ": a root or tip body ('link0', '') chooses the chain in an MJCF "
+                                  "scene (--root-body, --tip-body; root_body, tip_body in a "
+                                  "configuration); a URDF or DH table describes one robot already: "
+                                  "leave them out"),
+              std::string::npos)
         << e.what();
   }
 }
