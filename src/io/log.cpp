@@ -1,6 +1,7 @@
 #include "extwrench/io/log.hpp"
 
 #include <cmath>
+#include <limits>
 #include <set>
 
 #include "extwrench/core/error.hpp"
@@ -173,6 +174,9 @@ bool LogReader::read_row(Sample& s) {
     vec3(col_f_, tr.force_W);
     vec3(col_m_, tr.moment_W);
     vec3(col_p_, tr.point_W);
+    // Without true_p* columns the point is unknown, not the world origin: the metrics measured
+    // from it (line of action, surface point) are then not evaluated.
+    if (col_p_.empty()) tr.point_W.setConstant(std::numeric_limits<double>::quiet_NaN());
   }
   if (layout_.true_tau_ext) read_vector(col_tau_ext_, s.truth.tau_ext);
   return true;

@@ -98,12 +98,15 @@ void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate
   } else if (est.link == truth.body) {
     ++m_.right_link;
   }
+  // A log without the true point (no true_p* columns: NaN) has no line or point error to count.
+  const bool point_known = truth.point_W.allFinite();
   if (est.contact && est.has(EstimateFlag::kLineOfAction)) {
-    m_.line.add(point_line_distance(truth.point_W, est.line_point_W, est.line_direction_W));
+    if (point_known)
+      m_.line.add(point_line_distance(truth.point_W, est.line_point_W, est.line_direction_W));
   } else {
     ++m_.line_not_estimated;
   }
-  if (est.contact && est.has(EstimateFlag::kSurfacePoint))
+  if (point_known && est.contact && est.has(EstimateFlag::kSurfacePoint))
     m_.surface.add((est.point_W - truth.point_W).norm());
   if (est.contact && est.has(EstimateFlag::kForce) && std::isfinite(est.sigma_force)) {
     const double error = (est.force_W - truth.force_W).norm();

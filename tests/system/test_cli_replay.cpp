@@ -247,6 +247,19 @@ TEST_F(RealLog, EverySensorTypeRunsOnALogWithoutTruthAndDrawsEveryFigure) {
                        "out_ft_truth/metrics.json of an earlier run (this log has no "
                        "truth columns, so no metrics)"))
       << again.err;
+  // Truth without the contact point (true_link and true_f* only, as a force plate gives): the
+  // line and point errors are not evaluated. They were measured from the world origin (0.73 m).
+  write_text(dir_ / "force_truth_log.csv",
+             test::drop_columns(read_text(dir_ / "sim/log.csv"), {"true_p", "true_m"}));
+  const CliRun no_point = estimate(config("cfg_ft", types[0].second), "out_ft_no_point",
+                                   "--no-figures", "force_truth_log.csv");
+  ASSERT_EQ(no_point.code, 0) << no_point.err;
+  const std::string json = read_text(dir_ / "out_ft_no_point/metrics.json");
+  EXPECT_TRUE(contains(json,
+                       "\"line_of_action_distance\": {\"rms\": null, \"max\": null, "
+                       "\"samples\": 0"))
+      << json;
+  EXPECT_FALSE(contains(json, "\"force_error\": {\"rms\": null")) << json;
 }
 
 // A cell's number; NaN for empty or text cells ("ok", "link6").

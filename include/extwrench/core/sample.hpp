@@ -16,7 +16,7 @@ struct Truth {
   int contacts = 0;                    ///< number of active contacts
   Vector3 force_W = Vector3::Zero();   ///< F_ext [N]
   Vector3 moment_W = Vector3::Zero();  ///< pure moment M_ext [N m]
-  Vector3 point_W = Vector3::Zero();   ///< contact point p [m]
+  Vector3 point_W = Vector3::Zero();   ///< contact point p [m]; NaN when a log has no true_p*
   VectorX tau_ext;                     ///< (n) τ_ext [N m | N]
 };
 
