@@ -8,6 +8,7 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/core/input_checks.hpp"
+#include "extwrench/core/time_step.hpp"
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/momentum.hpp"
@@ -146,8 +147,18 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
     tare_.bias_S.setZero();
     tare_.request(options_.sensor.tare_samples);
   }
+  // Nothing of the previous run's estimate stays in result(): as a fresh estimator's after its
+  // first reset (no estimate yet, r = 0).
+  {
+    VectorX residual = std::move(out_.residual);  // keeps the buffers (no allocation)
+    VectorX offset = std::move(out_.torque_offset);
+    out_ = ContactEstimate{};
+    out_.residual = std::move(residual);
+    out_.torque_offset = std::move(offset);
+  }
   out_.residual.setZero();
   if (options_.drift) {  // back to the configured bias, as a fresh estimator (offsets: above)
+    out_.torque_offset = initial_offset_;
     if (options_.sensor.tare_samples == 0) tare_.bias_S = options_.sensor.bias_S;
     drift_quiet_since_ = t;
     drift_t_prev_ = t;
@@ -181,12 +192,19 @@ Status ContactEstimator::validate_sample(double t, const Eigen::Ref<const Vector
                                          const Eigen::Ref<const VectorX>& dq,
                                          const Eigen::Ref<const VectorX>& tau,
                                          const Vector6& reading_S) const noexcept {
+  // The estimator's own clock: update_with() advances it without the observer's.
+  if (std::isfinite(t) && !(t - t_ >= kShortestTimeStep))
+    return {StatusCode::kNonIncreasingTime, Channel::kTime, 0};
   if (Status s = observer_.validate(t, q, dq, tau); !s.ok()) return s;
   return check_reading(options_.sensor.type, reading_S);
 }
 
 void ContactEstimator::fail(double t, Status s) noexcept {
   // Outputs only: no state is touched, so the next good sample continues as if this one never came.
+  // The declaration in force stays (the detector did not change): a monitor reading `contact`
+  // sees no gap in a contact for a sample it could not use.
+  const bool declared = initialized_ && detector_.result().contact;
+  const int link = declared ? out_.link : -1;
   VectorX residual = std::move(out_.residual);  // keeps the buffers (no allocation)
   VectorX offset = std::move(out_.torque_offset);
   out_ = ContactEstimate{};
@@ -195,6 +213,9 @@ void ContactEstimator::fail(double t, Status s) noexcept {
   out_.residual.setConstant(kNaN);
   out_.t = t;
   out_.status = s;
+  out_.contact = declared;
+  out_.link = link;
+  if (declared) out_.flags = EstimateFlag::kContact;
 }
 
 Status ContactEstimator::update(const Sample& s) noexcept {
@@ -222,7 +243,8 @@ Status ContactEstimator::update(double t, const Eigen::Ref<const VectorX>& q,
                                 const Eigen::Ref<const VectorX>& dq,
                                 const Eigen::Ref<const VectorX>& tau,
                                 const Vector6& reading_S) noexcept {
-  if (!initialized_) {
+  // A moved-from estimator has no model left (nq -1): it needs a reset as a new one would.
+  if (!initialized_ || model_.nq() != n_) {
     fail(t, {StatusCode::kNotInitialized, Channel::kNone, -1});
     return out_.status;
   }
@@ -365,9 +387,11 @@ Status ContactEstimator::update_with(double t, const Eigen::Ref<const VectorX>& 
                                      const Eigen::Ref<const VectorX>& tau,
                                      const Vector6& reading_S) noexcept {
   Status s = Status::success();
-  if (!std::isfinite(t)) {
+  if (model_.nq() != n_) {  // moved from: no model left
+    s = {StatusCode::kNotInitialized, Channel::kNone, -1};
+  } else if (!std::isfinite(t)) {
     s = {StatusCode::kNonFinite, Channel::kTime, 0};
-  } else if (initialized_ && !(t > t_)) {
+  } else if (initialized_ && !(t - t_ >= kShortestTimeStep)) {
     s = {StatusCode::kNonIncreasingTime, Channel::kTime, 0};
   }
   if (s.ok()) s = check_vector(q, n_, Channel::kPosition);

@@ -5,6 +5,7 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/core/input_checks.hpp"
+#include "extwrench/core/time_step.hpp"
 #include "extwrench/dynamics/momentum.hpp"
 
 namespace extwrench {
@@ -153,7 +154,7 @@ Status MomentumObserver::validate(double t, const Eigen::Ref<const VectorX>& q,
                                   const Eigen::Ref<const VectorX>& tau) const noexcept {
   if (!initialized_) return {StatusCode::kNotInitialized, Channel::kNone, -1};
   if (!std::isfinite(t)) return {StatusCode::kNonFinite, Channel::kTime, 0};
-  if (!(t > t_)) return {StatusCode::kNonIncreasingTime, Channel::kTime, 0};
+  if (!(t - t_ >= kShortestTimeStep)) return {StatusCode::kNonIncreasingTime, Channel::kTime, 0};
   if (Status s = check_vector(q, n_, Channel::kPosition); !s.ok()) return s;
   if (Status s = check_vector(dq, n_, Channel::kVelocity); !s.ok()) return s;
   return check_vector(tau, n_, Channel::kTorque);

@@ -459,6 +459,71 @@ TEST(EstimatorRealTime, EstimatorIsAValueThatCopiesAndMovesWithItsState) {
   }
 }
 
+// What a loop sees around the samples the estimator cannot use (found by a review written as a
+// user's integration): each case failed, or crashed, before.
+TEST(EstimatorRealTime, RejectedSamplesKeepTheDeclaredContactAndTheClockAndResetStartsClean) {
+  const Samples s = make_samples(120, 6, 8);
+  const Model model = test::paper_arm_model();
+  EstimatorOptions o;
+  o.sensor.type = SensorType::kForceTorque;
+  ContactEstimator est(model, test::paper_arm_capsules(model), o);
+  ASSERT_TRUE(est.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+  int k = 1;
+  for (; k < 120 && !est.result().contact; ++k)
+    ASSERT_TRUE(est.update(k * 1e-3, s.q[k], s.dq[k], s.tau[k], s.reading[k]).ok());
+  ASSERT_TRUE(est.result().contact) << "the 20 N push is declared";
+  const int link = est.result().link;
+  // A sample with a NaN: rejected, but the contact declared before it is still declared (a
+  // safety monitor reading `contact` saw a gap); its numbers are NaN.
+  VectorX bad = s.q[k];
+  bad[2] = kNaN;
+  EXPECT_EQ(est.update(k * 1e-3, bad, s.dq[k], s.tau[k], s.reading[k]).code,
+            StatusCode::kNonFinite);
+  EXPECT_TRUE(est.result().contact);
+  EXPECT_EQ(est.result().link, link);
+  EXPECT_EQ(est.result().flags, EstimateFlag::kContact);
+  EXPECT_TRUE(est.result().force_W.array().isNaN().all());
+  // The estimator's clock, which update_with() advances too: an earlier t after it is refused
+  // (update() once checked only the observer's clock and went back in time).
+  ASSERT_TRUE(est.update_with(0.5, s.q[k], s.dq[k], VectorX::Zero(7), VectorX::Zero(7), s.tau[k],
+                              s.reading[k])
+                  .ok());
+  EXPECT_EQ(est.update(0.2, s.q[k], s.dq[k], s.tau[k], s.reading[k]).code,
+            StatusCode::kNonIncreasingTime);
+  // A time step below 1 ns (a subnormal one made the residual NaN for good, status ok).
+  ContactEstimator fresh(model, test::paper_arm_capsules(model), o);
+  ASSERT_TRUE(fresh.reset(0.0, s.q[0], s.dq[0], s.tau[0]).ok());
+  EXPECT_EQ(fresh.update(1e-310, s.q[1], s.dq[1], s.tau[1], s.reading[1]).code,
+            StatusCode::kNonIncreasingTime);
+  ASSERT_TRUE(fresh.update(1e-3, s.q[1], s.dq[1], s.tau[1], s.reading[1]).ok());
+  EXPECT_TRUE(fresh.result().residual.allFinite());
+  // A NaN sensor bias is refused and leaves the bias as it was.
+  const Vector6 bias = fresh.sensor_bias();
+  Vector6 nan_bias = Vector6::Zero();
+  nan_bias[4] = kNaN;
+  const Status st = fresh.set_sensor_bias(nan_bias);
+  EXPECT_EQ(st.code, StatusCode::kNonFinite);
+  EXPECT_EQ(st.index, 4);
+  EXPECT_EQ(fresh.sensor_bias(), bias);
+  // reset() keeps nothing of the previous run's estimate (it showed the old contact and force).
+  ASSERT_TRUE(est.reset(10.0, s.q[k], s.dq[k], s.tau[k]).ok());
+  EXPECT_FALSE(est.result().contact);
+  EXPECT_EQ(est.result().link, -1);
+  EXPECT_EQ(est.result().flags, 0u);
+  EXPECT_TRUE(est.result().force_W.array().isNaN().all());
+  EXPECT_TRUE(est.result().residual.isZero(0.0));
+  // A moved-from estimator answers kNotInitialized (it crashed in the momentum pass).
+  ContactEstimator moved = std::move(fresh);
+  EXPECT_EQ(fresh.update(0.01, s.q[2], s.dq[2], s.tau[2], s.reading[2]).code,  // NOLINT
+            StatusCode::kNotInitialized);
+  EXPECT_EQ(fresh
+                .update_with(0.01, s.q[2], s.dq[2], VectorX::Zero(7), VectorX::Zero(7), s.tau[2],
+                             s.reading[2])
+                .code,
+            StatusCode::kNotInitialized);
+  EXPECT_TRUE(moved.update(2e-3, s.q[2], s.dq[2], s.tau[2], s.reading[2]).ok());
+}
+
 TEST(EstimatorRealTime, UpdateFromASampleServesEverySensorTypeBitForBitWithoutAllocation) {
   const Samples s = make_samples(60, 7, 5);
   const Model model = test::paper_arm_model();

@@ -33,7 +33,10 @@ enum class Channel : std::uint8_t {
 struct Status {
   StatusCode code = StatusCode::kOk;
   Channel channel = Channel::kNone;
-  int index = -1;  ///< element of the channel, -1 when not applicable
+  /// kNonFinite: the element of the channel; kWrongSize: the size received (the expected one is
+  /// the robot's n; 0 on base_wrench: the configured sensor's reading is missing; set_payload:
+  /// the body index given); kNonIncreasingTime: 0; otherwise -1.
+  int index = -1;
 
   [[nodiscard]] constexpr bool ok() const noexcept { return code == StatusCode::kOk; }
   static constexpr Status success() noexcept { return {}; }

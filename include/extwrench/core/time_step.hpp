@@ -1,11 +1,16 @@
-// A log's time column taken as seconds: the one rule by which `estimate` notes a log and
-// `calibrate` refuses it.
+// Time steps: the shortest an estimator accepts, and a log's time column taken as seconds (the
+// one rule by which `estimate` notes a log and `calibrate` refuses it).
 #pragma once
 
 #include <cstdio>
 #include <string>
 
 namespace extwrench {
+
+/// The shortest time step [s] between two samples an estimator accepts: 1 ns. A step below it
+/// (a repeated or subnormally close time stamp) is kNonIncreasingTime: divided by, it would make
+/// the residual NaN for good.
+inline constexpr double kShortestTimeStep = 1e-9;
 
 /// The longest mean time step [s] of a log taken as timed in seconds: 50 ms (20 Hz, where a
 /// robot's controller logs at 100 Hz to 1 kHz). Beyond it t is likely in milliseconds or counts

@@ -22,6 +22,7 @@
 // bit-identical results to a run that never saw the bad one).
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "extwrench/core/sample.hpp"
@@ -81,7 +82,14 @@ class ContactEstimator {
   void request_tare(int samples) noexcept { tare_.request(samples); }
   /// Sensor bias [f; n] in the sensor frame (subtracted from every reading).
   [[nodiscard]] const Vector6& sensor_bias() const noexcept { return tare_.bias_S; }
-  void set_sensor_bias(const Vector6& bias_S) noexcept { tare_.bias_S = bias_S; }
+  /// kNonFinite (index: the entry) for a NaN or Inf entry, and the bias is left as it was: every
+  /// later force would be NaN.
+  Status set_sensor_bias(const Vector6& bias_S) noexcept {
+    for (int i = 0; i < 6; ++i)
+      if (!std::isfinite(bias_S[i])) return {StatusCode::kNonFinite, Channel::kBaseWrench, i};
+    tare_.bias_S = bias_S;
+    return Status::success();
+  }
 
   /// Adds a payload (mass properties in the frame of `body`) to body `body` of model(),
   /// replacing any previous payload; the observer is re-anchored so that r stays continuous.

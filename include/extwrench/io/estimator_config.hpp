@@ -1,4 +1,5 @@
 // The estimator's configuration file (YAML; documented in docs/config.md):
+// clang-format off
 //
 //   robot: ../models/paper_arm.urdf   # URDF or DH YAML, relative to this file (required)
 //   locked_joints: {finger_1: 0.02}   # joints held fixed [rad | m] (a tree's branches)
@@ -15,10 +16,11 @@
 //   observer: {gain: 100}             # K [1/s]: number or list of n
 //   detection: {tau_min: 1.0, f_min: 5.0, release_ratio: 0.5, min_duration: 0.005}
 //   acceleration: residual            # residual | differentiation | {route: ..., cutoff: 50}
-//   friction: model                   # model | none | {viscous: .., coulomb: ..,
-//   smoothing_velocity: ..} payload: {link: link7, mass: 0.5, com: [0, 0, 0.05], inertia: [ixx,
-//   ixy, ixz, iyy, iyz, izz]} solver: {max_condition: 1000, rank_tolerance: 1e-6}
+//   friction: model                   # model | none | {viscous, coulomb, smoothing_velocity}
+//   payload: {link: link7, mass: 0.5, com: [0, 0, 0.05], inertia: [ixx, ixy, ixz, iyy, iyz, izz]}
+//   solver: {max_condition: 1000, rank_tolerance: 1e-6}
 //
+// clang-format on
 // Every key but robot and sensor.type has a default. Unknown keys, wrong types and values out of
 // range throw extwrench::Error naming the file, the line and the key.
 #pragma once
