@@ -1,5 +1,6 @@
 #include "extwrench/dynamics/crba.hpp"
 
+#include "argument_checks.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "spatial.hpp"
@@ -75,6 +76,8 @@ namespace {
 }  // namespace
 
 const MatrixX& crba(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  detail::check_data("crba", model, data);
+  detail::check_joint_vector("crba", "q", q.size(), model);
   // forward_kinematics + crba_no_kinematics fused: each body's world mass properties go straight
   // into the composite arrays (no copy pass, no data.mass / first_moment_W / inertia_O_W), and
   // along a chain the child's composite is carried in registers.
@@ -167,6 +170,8 @@ const MatrixX& crba(const Model& model, Data& data, const Eigen::Ref<const Vecto
 
 bool forward_dynamics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                       const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau) {
+  detail::check_joint_vector("forward_dynamics", "dq", dq.size(), model);
+  detail::check_joint_vector("forward_dynamics", "tau", tau.size(), model);
   forward_kinematics(model, data, q);
   crba_no_kinematics(model, data);
   data.tmp_n.setZero();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "argument_checks.hpp"
 #include "spatial.hpp"
 
 namespace extwrench {
@@ -22,11 +23,15 @@ double svd_condition(const Eigen::MatrixBase<Derived>& J) {
 }  // namespace
 
 void forward_kinematics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  detail::check_data("forward_kinematics", model, data);
+  detail::check_joint_vector("forward_kinematics", "q", q.size(), model);
   detail::poses_and_subspaces(model, data, q);
   world_mass_properties(model, data);
 }
 
 void forward_poses(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  detail::check_data("forward_poses", model, data);
+  detail::check_joint_vector("forward_poses", "q", q.size(), model);
   detail::poses_and_subspaces(model, data, q);
 }
 
@@ -42,6 +47,11 @@ Pose frame_pose(const Model& model, const Data& data, int frame) {
 
 void point_jacobian(const Model& model, const Data& data, int body, const Vector3& p_W,
                     Eigen::Ref<Matrix6X> J) {
+  detail::check_body("point_jacobian", "body", body, model);
+  if (J.cols() != model.nq()) [[unlikely]]
+    detail::argument_error("point_jacobian", "J has " + std::to_string(J.cols()) +
+                                                 " columns, the model has " +
+                                                 std::to_string(model.nq()) + " joints");
   J.setZero();
   // Point velocity = v_O + w x p: column j = [S_lin + S_ang x p; S_ang] for the ancestors j.
   for (int j = body; j > 0; j = model.parents[j]) {
@@ -52,6 +62,7 @@ void point_jacobian(const Model& model, const Data& data, int body, const Vector
 }
 
 const Matrix6X& body_jacobian(const Model& model, Data& data, int body) {
+  detail::check_body("body_jacobian", "body", body, model);
   point_jacobian(model, data, body, data.X_WB[body].translation, data.J);
   return data.J;
 }

@@ -1,5 +1,6 @@
 #include "extwrench/dynamics/rnea.hpp"
 
+#include "argument_checks.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "spatial.hpp"
 
@@ -100,6 +101,12 @@ template <typename V>
 const VectorX& rnea(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& ddq,
                     std::span<const ExternalWrench> external) {
+  detail::check_data("rnea", model, data);
+  detail::check_joint_vector("rnea", "q", q.size(), model);
+  detail::check_joint_vector("rnea", "dq", dq.size(), model);
+  detail::check_joint_vector("rnea", "ddq", ddq.size(), model);
+  for (const ExternalWrench& w : external)
+    detail::check_body("rnea", "external wrench body", w.body, model);
   // Featherstone's form in each body's joint-aligned frame J_i (Data::aligned): the motion
   // comes into J_i through E'_i(q)^T = Rz(q)^T P'^T, Newton-Euler uses J_i's constant mass
   // properties about its origin, and the wrench goes back through E'_i. The joint is e_z there,
@@ -229,6 +236,11 @@ const VectorX& rnea_no_kinematics(const Model& model, Data& data,
                                   const Eigen::Ref<const VectorX>& dq,
                                   const Eigen::Ref<const VectorX>& ddq,
                                   std::span<const ExternalWrench> external, bool with_gravity) {
+  detail::check_data("rnea_no_kinematics", model, data);
+  detail::check_joint_vector("rnea_no_kinematics", "dq", dq.size(), model);
+  detail::check_joint_vector("rnea_no_kinematics", "ddq", ddq.size(), model);
+  for (const ExternalWrench& w : external)
+    detail::check_body("rnea_no_kinematics", "external wrench body", w.body, model);
   const int nb = model.num_bodies();
   // Forward pass. Gravity trick: the base accelerates with -g (docs/method.md).
   data.v[0].setZero();
@@ -284,6 +296,8 @@ const VectorX& bias_torques(const Model& model, Data& data, const Eigen::Ref<con
 }
 
 const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q) {
+  detail::check_data("gravity_torques", model, data);
+  detail::check_joint_vector("gravity_torques", "q", q.size(), model);
   // g_i = -S_i^T [m^c_i g; h^c_i x g] (the subtree's weight as a wrench), evaluated in body i's
   // own frame, where S_i is the constant data.S_B[i]: no world pose, no inertia tensor, no
   // velocity. Forward: the gravity vector in each body's axes, g_i = E_i(q)^T g_p. Backward: the
@@ -357,6 +371,7 @@ const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<
 
 const MatrixX& coriolis_matrix(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                                const Eigen::Ref<const VectorX>& dq) {
+  detail::check_joint_vector("coriolis_matrix", "dq", dq.size(), model);
   forward_kinematics(model, data, q);
   const int nb = model.num_bodies();
   data.v[0].setZero();
