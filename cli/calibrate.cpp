@@ -103,7 +103,7 @@ void register_calibrate(CLI::App& app) {
       ->type_name("FORM");
   sub->add_flag("--payload", opt->arguments.payload,
                 "Identify a payload (mass, CoM) on the last link from the base F/T sensor and add "
-                "it to the model (needs sensor.type: ft)");
+                "it to the model (needs sensor.type: ft or force)");
   sub->add_flag("--known-torque", opt->arguments.known_torque,
                 "The log is not contact-free but its true_tau_ext1..n columns hold the external "
                 "torque known during the recording (e.g. J_v^T F of a force plate under the "
