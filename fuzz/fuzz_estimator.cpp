@@ -20,6 +20,8 @@
 #include <optional>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/core/input_checks.hpp"
+#include "extwrench/core/time_step.hpp"
 #include "extwrench/estimation/contact_estimator.hpp"
 #include "extwrench/io/robot_loader.hpp"
 
@@ -220,11 +222,14 @@ bool has_defect(const ContactEstimator& e, const Decoded& s, double t_last) {
   const int n = e.model().nq();
   const SensorType type = e.options().sensor.type;
   if (type != SensorType::kNone && s.mode != ReadingMode::kGiven) return true;
-  if (!std::isfinite(s.t) || !(s.t > t_last)) return true;
-  for (const VectorX* v : {&s.q, &s.dq, &s.tau})
-    if (v->size() != n || !v->allFinite()) return true;
+  if (!std::isfinite(s.t) || !(s.t - t_last >= kShortestTimeStep)) return true;
+  for (const VectorX* v : {&s.q, &s.dq, &s.tau}) {
+    if (v->size() != n) return true;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (!usable_input((*v)[i])) return true;
+  }
   for (int i = 0; i < reading_size(type); ++i)
-    if (!std::isfinite(s.reading_S[i])) return true;
+    if (!usable_input(s.reading_S[i])) return true;
   return false;
 }
 
@@ -237,16 +242,16 @@ bool blame_is_right(const ContactEstimator& e, const Decoded& s, Status status, 
                                                             : nullptr;
   switch (status.code) {
     case StatusCode::kNonIncreasingTime:
-      return status.channel == Channel::kTime && !(s.t > t_last);
+      return status.channel == Channel::kTime && !(s.t - t_last >= kShortestTimeStep);
     case StatusCode::kWrongSize:
       if (status.channel == Channel::kBaseWrench) return s.mode != ReadingMode::kGiven;
       return v != nullptr && v->size() != n;
     case StatusCode::kNonFinite:
       if (status.channel == Channel::kTime) return !std::isfinite(s.t);
       if (status.channel == Channel::kBaseWrench)
-        return status.index >= 0 && status.index < 6 && !std::isfinite(s.reading_S[status.index]);
+        return status.index >= 0 && status.index < 6 && !usable_input(s.reading_S[status.index]);
       return v != nullptr && status.index >= 0 && status.index < v->size() &&
-             !std::isfinite((*v)[status.index]);
+             !usable_input((*v)[status.index]);
     default:
       return false;
   }
@@ -262,10 +267,13 @@ bool same_bits(const Eigen::MatrixBase<Derived>& a, const Eigen::MatrixBase<Deri
   return true;
 }
 
+// A rejected sample's result: every number NaN; the declaration in force kept (contact and its
+// link, the flag `contact` alone), or none.
 bool all_nan(const ContactEstimate& out) {
   return out.force_W.array().isNaN().all() && out.moment_W.array().isNaN().all() &&
-         out.point_W.array().isNaN().all() && out.residual.array().isNaN().all() && !out.contact &&
-         out.link == -1 && out.flags == 0;
+         out.point_W.array().isNaN().all() && out.residual.array().isNaN().all() &&
+         out.flags == (out.contact ? EstimateFlag::kContact : 0u) &&
+         (out.contact || out.link == -1);
 }
 
 void check_rejection(const ContactEstimator& e, const Decoded& s, Status status, double t_last) {

@@ -497,6 +497,16 @@ TEST(EstimatorRealTime, RejectedSamplesKeepTheDeclaredContactAndTheClockAndReset
             StatusCode::kNonIncreasingTime);
   ASSERT_TRUE(fresh.update(1e-3, s.q[1], s.dq[1], s.tau[1], s.reading[1]).ok());
   EXPECT_TRUE(fresh.result().residual.allFinite());
+  // A finite but huge input (1e200 rad/s: its square overflows) is refused as kNonFinite; it
+  // left a NaN force with status ok for good. The next good sample goes on as before.
+  VectorX huge = s.dq[2];
+  huge[3] = 1e200;
+  const Status big = fresh.update(2e-3, s.q[2], huge, s.tau[2], s.reading[2]);
+  EXPECT_EQ(big.code, StatusCode::kNonFinite);
+  EXPECT_EQ(big.channel, Channel::kVelocity);
+  EXPECT_EQ(big.index, 3);
+  ASSERT_TRUE(fresh.update(2e-3, s.q[2], s.dq[2], s.tau[2], s.reading[2]).ok());
+  EXPECT_TRUE(fresh.result().residual.allFinite());
   // A NaN sensor bias is refused and leaves the bias as it was.
   const Vector6 bias = fresh.sensor_bias();
   Vector6 nan_bias = Vector6::Zero();
@@ -521,7 +531,7 @@ TEST(EstimatorRealTime, RejectedSamplesKeepTheDeclaredContactAndTheClockAndReset
                              s.reading[2])
                 .code,
             StatusCode::kNotInitialized);
-  EXPECT_TRUE(moved.update(2e-3, s.q[2], s.dq[2], s.tau[2], s.reading[2]).ok());
+  EXPECT_TRUE(moved.update(3e-3, s.q[3], s.dq[3], s.tau[3], s.reading[3]).ok());
 }
 
 TEST(EstimatorRealTime, UpdateFromASampleServesEverySensorTypeBitForBitWithoutAllocation) {

@@ -9,13 +9,22 @@
 
 namespace extwrench {
 
-/// ok when v has n entries, all finite; else kWrongSize (index = v's size) or kNonFinite (index
-/// of the first bad entry) on `channel`.
+/// The largest magnitude a per-sample input may have: 1e9 (in SI units and radians no robot's q,
+/// q̇, τ or base reading comes near it). A finite input beyond it, squared in the Coriolis terms
+/// or integrated by the observer, overflows and leaves the state non-finite for good; it is
+/// refused as kNonFinite.
+inline constexpr double kLargestInput = 1e9;
+
+/// Whether x is a usable input: finite and |x| <= kLargestInput (one comparison; NaN fails it).
+[[nodiscard]] inline bool usable_input(double x) noexcept { return std::abs(x) <= kLargestInput; }
+
+/// ok when v has n entries, all usable (usable_input); else kWrongSize (index = v's size) or
+/// kNonFinite (index of the first bad entry) on `channel`.
 [[nodiscard]] inline Status check_vector(const Eigen::Ref<const VectorX>& v, int n,
                                          Channel channel) noexcept {
   if (v.size() != n) return {StatusCode::kWrongSize, channel, static_cast<int>(v.size())};
   for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v[i])) return {StatusCode::kNonFinite, channel, i};
+    if (!usable_input(v[i])) return {StatusCode::kNonFinite, channel, i};
   }
   return Status::success();
 }

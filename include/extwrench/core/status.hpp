@@ -12,7 +12,7 @@ enum class StatusCode : std::uint8_t {
   kOk = 0,
   // Input errors: nothing was changed.
   kWrongSize,          ///< an input vector has the wrong size
-  kNonFinite,          ///< NaN or Inf in an input
+  kNonFinite,          ///< NaN or Inf in an input, or a magnitude above kLargestInput (1e9)
   kNonIncreasingTime,  ///< the time stamp did not increase
   kNotInitialized,     ///< reset() was not called
   // Numerical outcomes.

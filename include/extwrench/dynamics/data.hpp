@@ -18,7 +18,8 @@ struct Data {
   /// True if this Data was sized for `model` and its cached terms (rotation_const, rotation_cos,
   /// rotation_sin and their transposes, axis_P, S_B, slide_P, aligned) are those of model's joints
   /// and bodies: a Data built for one Model is not valid for another of the same size whose joint
-  /// axes, placements or inertias differ.
+  /// axes, placements or inertias differ. After editing a Model, build a new Data: the dynamics
+  /// functions check the sizes, not this (a full comparison per call).
   [[nodiscard]] bool matches(const Model& model) const;
 
   // --- derived from the model once, for the hot path ---

@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "extwrench/core/input_checks.hpp"
 #include "extwrench/core/status.hpp"
 #include "extwrench/core/types.hpp"
 #include "extwrench/model/model.hpp"
@@ -43,7 +44,7 @@ enum class SensorType : std::uint8_t {
 [[nodiscard]] inline Status check_reading(SensorType type, const Vector6& reading_S) noexcept {
   const int count = reading_size(type);
   for (int i = 0; i < count; ++i) {
-    if (!std::isfinite(reading_S[i])) return {StatusCode::kNonFinite, Channel::kBaseWrench, i};
+    if (!usable_input(reading_S[i])) return {StatusCode::kNonFinite, Channel::kBaseWrench, i};
   }
   return Status::success();
 }
