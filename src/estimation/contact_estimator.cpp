@@ -149,13 +149,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   }
   // Nothing of the previous run's estimate stays in result(): as a fresh estimator's after its
   // first reset (no estimate yet, r = 0).
-  {
-    VectorX residual = std::move(out_.residual);  // keeps the buffers (no allocation)
-    VectorX offset = std::move(out_.torque_offset);
-    out_ = ContactEstimate{};
-    out_.residual = std::move(residual);
-    out_.torque_offset = std::move(offset);
-  }
+  clear_output();
   out_.residual.setZero();
   if (options_.drift) {  // back to the configured bias, as a fresh estimator (offsets: above)
     out_.torque_offset = initial_offset_;
@@ -205,11 +199,7 @@ void ContactEstimator::fail(double t, Status s) noexcept {
   // sees no gap in a contact for a sample it could not use.
   const bool declared = initialized_ && detector_.result().contact;
   const int link = declared ? out_.link : -1;
-  VectorX residual = std::move(out_.residual);  // keeps the buffers (no allocation)
-  VectorX offset = std::move(out_.torque_offset);
-  out_ = ContactEstimate{};
-  out_.residual = std::move(residual);
-  out_.torque_offset = std::move(offset);
+  clear_output();
   out_.residual.setConstant(kNaN);
   out_.t = t;
   out_.status = s;
@@ -419,13 +409,17 @@ Status ContactEstimator::update_with(double t, const Eigen::Ref<const VectorX>& 
   return out_.status;
 }
 
-void ContactEstimator::begin_output(double t) noexcept {
-  const Status status = out_.status;
-  VectorX residual = std::move(out_.residual);  // fresh output, keeping the buffers
+void ContactEstimator::clear_output() noexcept {
+  VectorX residual = std::move(out_.residual);
   VectorX offset = std::move(out_.torque_offset);
   out_ = ContactEstimate{};
   out_.residual = std::move(residual);
   out_.torque_offset = std::move(offset);
+}
+
+void ContactEstimator::begin_output(double t) noexcept {
+  const Status status = out_.status;
+  clear_output();
   out_.status = status;
   out_.t = t;
   out_.residual = tau_ext_;

@@ -151,6 +151,9 @@ class ContactEstimator {
                          const Vector6& reading_S) const noexcept;
   void fail(double t, Status s) noexcept;
   void begin_output(double t) noexcept;
+  /// out_ back to a default ContactEstimate, keeping its residual and torque_offset buffers (no
+  /// allocation; their values are the caller's to set).
+  void clear_output() noexcept;
   void apply_payload(int body, const Inertia* payload) noexcept;
 
   EstimatorOptions options_;
