@@ -294,6 +294,7 @@ py::dict metrics_py(const py::dict& truth, const py::dict& estimates, double fro
   d["right_link_samples"] = m.right_link;
   d["missed_detections"] = m.missed;
   d["false_alarms"] = m.false_alarms;
+  d["false_alarms_release"] = m.false_alarms_release;
   d["false_alarm_rate"] = m.false_alarm_rate();
   py::dict u;
   u["samples"] = m.sigma_samples;
@@ -303,6 +304,7 @@ py::dict metrics_py(const py::dict& truth, const py::dict& estimates, double fro
   d["uncertainty"] = u;
   d["onsets"] = m.onsets;
   d["onsets_detected"] = m.onsets_detected;
+  d["onsets_already_declared"] = m.onsets_already_declared;
   d["mean_detection_delay"] = m.mean_detection_delay();
   d["max_detection_delay"] = m.delay_max;
   return d;

@@ -69,6 +69,7 @@ std::string metrics_json(const MetricsReport& r) {
     o += "      \"right_link_samples\": " + std::to_string(m.right_link) + ",\n";
     o += "      \"missed_detections\": " + std::to_string(m.missed) + ",\n";
     o += "      \"false_alarms\": " + std::to_string(m.false_alarms) + ",\n";
+    o += "      \"false_alarms_release\": " + std::to_string(m.false_alarms_release) + ",\n";
     o += "      \"false_alarm_rate\": " + num(m.false_alarm_rate()) + ",\n";
     o += "      \"uncertainty\": {\"samples\": " + std::to_string(m.sigma_samples) +
          ", \"force_within_2sigma\": " + num(m.force_two_sigma_coverage()) +
@@ -83,6 +84,7 @@ std::string metrics_json(const MetricsReport& r) {
   o += "  \"detection_delay\": {\"window\": \"whole log\", \"onsets\": " +
        std::to_string(any ? any->onsets : 0) +
        ", \"detected\": " + std::to_string(any ? any->onsets_detected : 0) +
+       ", \"already_declared\": " + std::to_string(any ? any->onsets_already_declared : 0) +
        ", \"mean\": " + num(any ? any->mean_detection_delay() : std::nan("")) +
        ", \"max\": " + num(any && any->onsets_detected > 0 ? any->delay_max : std::nan("")) +
        ", \"unit\": \"s\"}\n";

@@ -1,5 +1,6 @@
 #include "extwrench/sim/metrics.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace extwrench::sim {
@@ -52,13 +53,20 @@ MetricsAccumulator::MetricsAccumulator(MetricsWindow window) { m_.window = std::
 
 void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate& est) noexcept {
   const bool touched = truth.body >= 0;
-  // Detection delay, over the whole log: onset = first sample of a contact.
+  // Detection delay, over the whole log: onset = first sample of a contact. A contact declared
+  // before it and still at it is no detection of this one (it would count a zero delay).
   if (touched && !in_contact_) {
     ++m_.onsets;
     onset_t_ = t;
-    waiting_detection_ = true;
+    const bool already = declared_ && est.contact;  // declared before, and not released
+    waiting_detection_ = !already;
+    if (already) ++m_.onsets_already_declared;
   }
+  // The release: from a true contact's end, as long as the declared contact lasts.
+  if (!touched && in_contact_) releasing_ = true;
+  if (!est.contact || touched) releasing_ = false;
   in_contact_ = touched;
+  declared_ = est.contact;
   if (!touched) waiting_detection_ = false;
   if (waiting_detection_ && est.contact) {
     const double delay = t - onset_t_;
@@ -81,14 +89,16 @@ void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate
     ++m_.force_not_estimated;
   }
   if (!est.contact) {
-    m_.moment.add(m_true.norm());
+    moment_undetected_.add(m_true.norm());
   } else if (est.has(EstimateFlag::kMoment)) {
+    moment_estimated_ = true;
     m_.moment.add((est.moment_W - m_true).norm());
   }
 
   if (!touched) {
     ++m_.free_samples;
     if (est.contact) ++m_.false_alarms;
+    if (releasing_) ++m_.false_alarms_release;
     return;
   }
   if (truth.contacts > 1) return;  // several contacts: link, line and point are not single-valued
@@ -119,6 +129,14 @@ void MetricsAccumulator::add(double t, const Truth& truth, const ContactEstimate
   }
 }
 
-Metrics MetricsAccumulator::result() const { return m_; }
+Metrics MetricsAccumulator::result() const {
+  Metrics m = m_;
+  if (moment_estimated_) {
+    m.moment.count += moment_undetected_.count;
+    m.moment.sum_sq += moment_undetected_.sum_sq;
+    m.moment.max = std::max(m.moment.max, moment_undetected_.max);
+  }
+  return m;
+}
 
 }  // namespace extwrench::sim

@@ -82,7 +82,8 @@ def test_metrics_equal_metrics_json(paper_run, cli_estimates):
     got = extwrench.estimate(est, log["t"], log["q"], log["dq"], log["tau"], log.get("reading"))
     m = extwrench.metrics(log, got, start=0.2)
     window = json.loads((cli_estimates[scheme] / "metrics.json").read_text())["windows"][0]
-    for key in ("samples", "contact_samples", "free_samples", "false_alarms", "isolation_accuracy",
+    for key in ("samples", "contact_samples", "free_samples", "false_alarms",
+                "false_alarms_release", "isolation_accuracy",
                 "right_link_samples", "missed_detections", "force_not_estimated"):
         assert m[key] == window[key], key
     for key in ("force_error", "moment_error", "line_of_action_distance"):

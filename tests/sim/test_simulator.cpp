@@ -491,6 +491,47 @@ TEST(Metrics, CountsFalseAlarmsMissesAndDetectionDelay) {
   EXPECT_NEAR(m.isolation_accuracy(), 1.0 / 3.0, 1e-15);
 }
 
+// Found by a review of the tuning workflow: a scheme always in contact had the best delay (0), the
+// release after a push counted as alarms alone, and a pure-force scheme reported a moment error
+// made of its undetected samples only.
+TEST(Metrics, TellsTheReleaseFromAlarmsAndMeasuresNoDelayForAContactAlreadyDeclared) {
+  MetricsAccumulator acc(MetricsWindow{});
+  Truth free_truth, contact;
+  contact.body = 2;
+  contact.contacts = 1;
+  contact.force_W = Vector3(0, 0, 3);
+  contact.moment_W = Vector3(0, 2, 0);
+  ContactEstimate none, declared;
+  declared.contact = true;
+  declared.link = 2;
+  declared.flags = EstimateFlag::kContact | EstimateFlag::kForce;  // no moment estimated
+  declared.force_W = Vector3(0, 0, 3);
+  acc.add(0.0, free_truth, none);
+  acc.add(0.1, contact, none);         // onset 1, missed
+  acc.add(0.2, contact, declared);     // detected after 0.1 s
+  acc.add(0.3, free_truth, declared);  // release
+  acc.add(0.4, free_truth, declared);  // release
+  acc.add(0.5, free_truth, none);      // released
+  acc.add(0.6, free_truth, declared);  // a new alarm, not the release
+  acc.add(0.7, contact, declared);     // onset 2: already declared, no delay
+  acc.add(0.8, free_truth, none);
+  Metrics m = acc.result();
+  EXPECT_EQ(m.onsets, 2);
+  EXPECT_EQ(m.onsets_detected, 1);
+  EXPECT_EQ(m.onsets_already_declared, 1);
+  EXPECT_NEAR(m.mean_detection_delay(), 0.1, 1e-15);
+  EXPECT_EQ(m.false_alarms, 3);
+  EXPECT_EQ(m.false_alarms_release, 2);
+  EXPECT_EQ(m.moment.count, 0);  // the configuration estimates no moment
+  // One estimated moment: the undetected samples count too (M̂ = 0 there).
+  declared.flags |= EstimateFlag::kMoment;
+  declared.moment_W = Vector3(0, 2, 0);
+  acc.add(0.9, contact, declared);
+  m = acc.result();
+  EXPECT_EQ(m.moment.count, 5);           // 0.9, and the four samples without a declared contact
+  EXPECT_NEAR(m.moment.max, 2.0, 1e-15);  // onset 1's missed sample: ‖M‖
+}
+
 TEST(Metrics, CountsTheForcesWithinTwoSigmaAndTheLargeErrorsLeftUnflagged) {
   MetricsAccumulator acc(MetricsWindow{});
   Truth contact;

@@ -37,7 +37,8 @@ struct Metrics {
   /// ‖F̂ − F‖ over every sample of the window where the estimator gave a force (F̂ = 0 when it
   /// reports no contact, F = 0 when free).
   ErrorStat force;
-  /// ‖M̂ − M‖, same rule with the moment.
+  /// ‖M̂ − M‖, same rule with the moment; empty (count 0) unless the estimator gave a moment on
+  /// some sample: a configuration that estimates none has no moment error to report.
   ErrorStat moment;
   /// Distance from the true point to the estimated line of action (in-contact samples with a line).
   ErrorStat line;
@@ -48,6 +49,9 @@ struct Metrics {
   long right_link = 0;           ///< in contact, detected on the right link
   long missed = 0;               ///< in contact, not detected
   long false_alarms = 0;         ///< free, contact reported
+  /// ... of which the release: the uninterrupted declared contact right after a true contact
+  /// ended (the residual decaying), not a new alarm.
+  long false_alarms_release = 0;
   // Uncertainty (issue 9): in-contact samples (single contact) with a force and its σ.
   long sigma_samples = 0;                ///< ... of which counted below
   long force_within_two_sigma = 0;       ///< ‖F̂ − F‖ ≤ 2 sigma_force
@@ -56,6 +60,9 @@ struct Metrics {
   // Detection delay: over the whole log (not windowed), from each onset of contact.
   long onsets = 0;
   long onsets_detected = 0;
+  /// Onsets at which a contact declared on the sample before is still declared (a false alarm,
+  /// or an earlier contact's release): no delay is measured for them.
+  long onsets_already_declared = 0;
   double delay_sum = 0.0;
   double delay_max = 0.0;
 
@@ -77,7 +84,11 @@ class MetricsAccumulator {
 
  private:
   Metrics m_;
+  ErrorStat moment_undetected_;  // M's norm where no contact was declared (merged if estimated)
+  bool moment_estimated_ = false;
   bool in_contact_ = false;
+  bool declared_ = false;   // the estimator declared contact on the previous sample
+  bool releasing_ = false;  // declared without a break since the last true contact ended
   bool waiting_detection_ = false;
   double onset_t_ = 0.0;
 };
