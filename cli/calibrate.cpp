@@ -21,6 +21,7 @@ struct CalibrateOptions {
   std::filesystem::path config, log, out;
   CalibrateArguments arguments;
   std::vector<std::filesystem::path> package_path;
+  std::vector<std::string> lock;
 };
 
 // "smoothing_velocity" -> "--smoothing-velocity"; values as typed; "--sign dahl".
@@ -43,8 +44,7 @@ void run_calibrate(const CalibrateOptions& opt) {
               "calibrate writes CALIB.yaml to a file, not to standard output (its report goes "
               "there); give a file path");
   check_output_file(opt.out, "--out", {opt.config, opt.log});
-  LoadOptions load;
-  load.package_path = opt.package_path;
+  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   const auto start = std::chrono::steady_clock::now();
   const CalibrateLogResult run =
@@ -118,6 +118,7 @@ void register_calibrate(CLI::App& app) {
                 "Ignore joint columns beyond the robot's n (q8, tau8 of a gripper on a 7-joint "
                 "arm); without it they are an error, as for estimate");
   add_package_path_option(*sub, opt->package_path);
+  add_lock_option(*sub, opt->lock);
   sub->footer(help_footer(
       {{"extwrench calibrate --config panda.yaml --log free.csv --out calib.yaml --holdout 0.4",
         "fit on the first 60 % of a contact-free log, report false alarms and the smallest "

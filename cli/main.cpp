@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/nearest_name.hpp"
 #ifdef EXTWRENCH_HAVE_MUJOCO
 #include "extwrench/bridges/mjcf.hpp"
 #include "extwrench/bridges/mujoco_engine.hpp"
@@ -42,32 +43,16 @@ Examples:
 Units are SI and radians throughout. Exit status: 0 success, 1 bad input file, 2 bad command line.
 Documentation: docs/cli.md (commands, CSV), docs/log_format.md, docs/config.md, README.md.)";
 
-// Edit distance between two short words, to suggest the command meant by a typo.
-std::size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diagonal = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
-}
-
 // A first argument that is neither an option nor a command: CLI11 says only "A subcommand is
 // required", without naming what was typed.
 std::string unknown_command(const CLI::App& app, const std::string& word) {
-  std::string names, nearest;
-  std::size_t best = 3;  // suggest only a near miss
+  std::string names;
+  std::vector<std::string> commands;
   for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
     names += (names.empty() ? "" : ", ") + sub->get_name();
-    const std::size_t d = edit_distance(word, sub->get_name());
-    if (d < best) best = d, nearest = sub->get_name();
+    commands.push_back(sub->get_name());
   }
+  const std::string nearest = extwrench::nearest_name(word, commands);  // only a near miss
   return "unknown command '" + word + "'" +
          (nearest.empty() ? std::string(".") : "; did you mean '" + nearest + "'?") +
          " The commands are " + names + ".";

@@ -111,6 +111,23 @@ void run_simulate(const SimulateOptions& opt) {
                    i, forces[i].start, scenario.simulation.duration);
     }
   }
+  // Likewise metrics windows beside the run: a table of dashes must not read as a failed run.
+  const double duration = scenario.simulation.duration;
+  if (scenario.metrics_from >= duration) {
+    std::fprintf(stderr,
+                 "extwrench simulate: note: metrics.from is %g s, at or after the run's end "
+                 "(duration %g s): no sample is measured, every metric is empty\n",
+                 scenario.metrics_from, duration);
+  }
+  for (std::size_t i = 0; i < scenario.metrics_exclude.size(); ++i) {
+    const auto& [from, to] = scenario.metrics_exclude[i];
+    if (from > duration || to < 0.0) {
+      std::fprintf(stderr,
+                   "extwrench simulate: note: metrics.exclude[%zu] [%g, %g] s lies outside the "
+                   "run (0 to %g s): it excludes nothing\n",
+                   i, from, to, duration);
+    }
+  }
   RunOptions run;
   run.figures = !opt.no_figures;
   run.progress = true;  // a line rewritten on a terminal, periodic lines elsewhere (--jobs 1)

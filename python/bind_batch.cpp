@@ -308,6 +308,8 @@ py::dict contact_summary_py(const Estimator& source, const py::handle& t, const 
   d["note"] = frequent_alarms_note(tally);
   d["disagreement_warning"] = disagreement_warning(tally);
   d["time_step_note"] = time_step_note(tally);
+  d["base_contact_warning"] = base_contact_warning(tally, model);
+  d["time_gap_note"] = time_gap_note(tally);
   return d;
 }
 

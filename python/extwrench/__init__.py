@@ -91,7 +91,8 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
     (N, n)); besides: flags (uint32 bits), point_L, line_direction_W (N, 3), surface_distance.
     With notes, what `extwrench estimate` notes on stderr is an EstimateWarning: contacts that
     look like the model's error (when the configuration includes no calibration), mostly
-    flagged 'disagreement', or samples more than 50 ms apart on average (t not in seconds?).
+    flagged 'disagreement', mostly on the base alone (the sensor's sign, pose or bias?), samples
+    more than 50 ms apart on average (t not in seconds?), or a gap in t.
     contact_summary() gives the counts.
     """
     est = _estimator_for(source, reading)
@@ -101,8 +102,12 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
                                               out["flags"])
         if summary["disagreement_warning"]:
             warnings.warn(summary["disagreement_warning"], EstimateWarning, stacklevel=2)
+        if summary["base_contact_warning"]:
+            warnings.warn(summary["base_contact_warning"], EstimateWarning, stacklevel=2)
         if summary["time_step_note"]:
             warnings.warn(summary["time_step_note"], EstimateWarning, stacklevel=2)
+        if summary["time_gap_note"]:
+            warnings.warn(summary["time_gap_note"], EstimateWarning, stacklevel=2)
         if summary["note"] and est.calibration_path is None:
             warnings.warn(summary["note"] + "; in Python: extwrench.calibrate(estimator, "
                           "'FREE.csv', out='CALIB.yaml')", EstimateWarning, stacklevel=2)
@@ -129,8 +134,10 @@ def contact_summary(estimates: Dict[str, Any],
     Returns samples, contact_samples, episodes (contacts declared anew), disagreement_samples,
     by_link {link name: contact samples}, duration [s], text (the command's line "contact: ..."),
     note (the note to calibrate when the contacts look like the model's error, else ""),
-    disagreement_warning (else "") and time_step_note (when the samples are more than 50 ms
-    apart on average: t not in seconds?, else "").
+    disagreement_warning (else ""), base_contact_warning (most contact samples on the base
+    alone, else ""), time_step_note (when the samples are more than 50 ms apart on average: t
+    not in seconds?, else "") and time_gap_note (one step over 50 ms and 20 times the mean, else
+    "").
     """
     est = _estimator_for(source, None)
     return _extwrench._contact_summary(est, estimates["t"], estimates["contact"],

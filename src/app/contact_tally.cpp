@@ -12,6 +12,10 @@ ContactTally::ContactTally(int bodies)
 
 void ContactTally::add(double t, bool contact, int link, bool disagreement) {
   if (rows == 0) t_begin = t;
+  if (rows > 0 && t - t_end > longest_step) {
+    longest_step = t - t_end;
+    longest_step_at = t;
+  }
   t_end = t;
   ++rows;
   if (contact) {
@@ -64,6 +68,24 @@ std::string disagreement_warning(const ContactTally& tally) {
          "not (`extwrench calibrate` on a contact-free log, docs/calibration.md)";
 }
 
+std::string base_contact_warning(const ContactTally& tally, const Model& model) {
+  constexpr long kMinContactSamples = 20;
+  const long on_base = tally.samples_by_link.empty() ? 0 : tally.samples_by_link.front();
+  if (tally.contact_samples < kMinContactSamples || 2 * on_base <= tally.contact_samples) return {};
+  char pct[32];
+  std::snprintf(pct, sizeof pct, "%.0f %%",
+                100.0 * static_cast<double>(on_base) / static_cast<double>(tally.contact_samples));
+  const std::string base = model.bodies.empty() ? "link 0" : model.bodies.front().name;
+  return std::string(pct) + " of the " + std::to_string(tally.contact_samples) +
+         " contact samples are on the base (" + base +
+         ", status base_only): the base sensor reads a wrench the robot's motion does not explain "
+         "while the joints feel nothing. Unless the base itself was pushed, check the sensor: its "
+         "sign convention (the reading is what the robot discharges onto it: at rest f_m = M g, "
+         "pointing down; docs/conventions.md#the-base-sensor), its pose (sensor.pose, or the "
+         "model's 'sensor' frame; rpy in "
+         "radians) and its bias (sensor.tare), and the robot's mass";
+}
+
 std::string frequent_alarms_note(const ContactTally& tally) {
   // A model error false-alarms in either of two ways (the real Panda uncalibrated: 35-45
   // episodes in 10.5 s; the paper arm with unmodelled friction: 99 % of the samples, 1-3 episodes,
@@ -108,6 +130,23 @@ std::string time_step_note(const ContactTally& tally) {
   return slow +
          ", and a robot's controller logs at 100 Hz to 1 kHz. If t is in milliseconds or counts "
          "samples, convert it: the observer and the filters integrate over these steps";
+}
+
+std::string time_gap_note(const ContactTally& tally) {
+  constexpr double kGap = 0.05;  // [s]: under 20 Hz
+  constexpr double kTimesTheMean = 20.0;
+  if (tally.rows < 3) return {};
+  const double mean = tally.duration() / static_cast<double>(tally.rows - 1);
+  if (!(tally.longest_step > kGap && tally.longest_step > kTimesTheMean * mean)) return {};
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the log has a gap: %.4g s between t = %.6g and %.6g s, against %.3g s per "
+                "step on average",
+                tally.longest_step, tally.longest_step_at - tally.longest_step,
+                tally.longest_step_at, mean);
+  return std::string(text) +
+         ". The observer integrates it as one step, so its residual jumps there and the "
+         "estimates after it settle again; replay the parts before and after it as two logs";
 }
 
 }  // namespace extwrench

@@ -7,6 +7,7 @@
 #include <exception>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <thread>
 
@@ -301,13 +302,28 @@ FigureRecorder::FigureRecorder(const Model& model, bool truth, bool base_sensor,
       dq_d_(model.nq()),
       ddq_d_(model.nq()) {}
 
+namespace {
+double true_link_condition(const Model& model, Data& data, bool truth, const Sample& s) {
+  if (!truth || s.truth.body <= 0) return kNaN;
+  forward_poses(model, data, s.q);  // all jacobian_condition needs
+  return jacobian_condition(model, data, s.truth.body);
+}
+}  // namespace
+
+std::function<double(const Sample&)> FigureRecorder::true_condition() const {
+  auto data = std::make_shared<Data>(model_);
+  return [&model = model_, truth = truth_, data](const Sample& s) {
+    return true_link_condition(model, *data, truth, s);
+  };
+}
+
 void FigureRecorder::add(const Sample& sample, const ContactEstimate& estimate,
-                         const ContactDetector& detector) {
+                         const ContactDetector& detector, double true_condition) {
   double* r = row_.data();
   const int n = model_.nq();
   r[kT] = sample.t;
   estimate_columns(sample, estimate, r);
-  truth_columns(sample, estimate, r);
+  truth_columns(sample, estimate, true_condition, r);
   detection_columns(sample, estimate, detector, r);
   if (desired_ != nullptr) desired_->evaluate(sample.t, q_d_, dq_d_, ddq_d_);
   for (int i = 0; i < n; ++i) {
@@ -360,19 +376,17 @@ void FigureRecorder::detection_columns(const Sample& s, const ContactEstimate& e
   r[kForceThreshold] = base_sensor_ ? d.options().f_min : kNaN;
 }
 
-void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, double* r) {
+void FigureRecorder::truth_columns(const Sample& s, const ContactEstimate& e, double true_condition,
+                                   double* r) {
   const bool touched = truth_ && s.truth.body >= 0;
   for (int k = 0; k < 3; ++k) {
     r[kFt + k] = truth_ ? (touched ? s.truth.force_W[k] : 0.0) : kNaN;
     r[kPt + k] = touched ? s.truth.point_W[k] : kNaN;
   }
   r[kTrueContact] = touched ? 1.0 : 0.0;
-  r[kCondTrue] = kNaN;
   // Every row (not only kept ones): the envelope keeps the singular peak (Fig. 10).
-  if (truth_ && s.truth.body > 0) {
-    forward_poses(model_, data_, s.q);  // all jacobian_condition needs
-    r[kCondTrue] = jacobian_condition(model_, data_, s.truth.body);
-  }
+  r[kCondTrue] =
+      std::isnan(true_condition) ? true_link_condition(model_, data_, truth_, s) : true_condition;
   r[kErrF] = kNaN;
   if (truth_) {
     const Vector3 f_true = s.truth.body >= 0 ? s.truth.force_W : Vector3::Zero();

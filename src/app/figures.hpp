@@ -6,6 +6,8 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -47,7 +49,15 @@ class FigureRecorder {
                  const sim::SinusoidalTrajectory* desired = nullptr);
 
   /// One replayed sample, the estimate at it and the detector that made it (its thresholds).
-  void add(const Sample& sample, const ContactEstimate& estimate, const ContactDetector& detector);
+  /// true_condition: cond(J) of the sample's true contact link as true_condition() computes it,
+  /// when the caller computed it elsewhere (a replay: on the reader's thread); NaN: computed here.
+  void add(const Sample& sample, const ContactEstimate& estimate, const ContactDetector& detector,
+           double true_condition = std::numeric_limits<double>::quiet_NaN());
+
+  /// cond(J) of a sample's true contact link (NaN without truth or contact), with a workspace
+  /// of its own: for another thread. The envelope keeps the singular peak (Fig. 10), so every
+  /// row needs it, a fifth of a replay's estimating thread otherwise.
+  [[nodiscard]] std::function<double(const Sample&)> true_condition() const;
 
   /// Writes the data and the scripts and runs gnuplot on them, every file through `outputs`;
   /// the figures in the order joints, force, line_point, condition, residual, robot3d.
@@ -57,7 +67,7 @@ class FigureRecorder {
   void estimate_columns(const Sample& s, const ContactEstimate& e, double* row);
   void detection_columns(const Sample& s, const ContactEstimate& e, const ContactDetector& d,
                          double* row) const;
-  void truth_columns(const Sample& s, const ContactEstimate& e, double* row);
+  void truth_columns(const Sample& s, const ContactEstimate& e, double true_condition, double* row);
 
   const Model& model_;
   bool truth_;

@@ -1,8 +1,12 @@
 #include "log_columns.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/number_text.hpp"
 
 namespace extwrench::detail {
 
@@ -51,6 +55,55 @@ void check_sensor_columns(const LogReader& reader, SensorType sensor) {
                 ":1: the configuration's sensor.type is 'force' but the log has no fs_x, fs_y, "
                 "fs_z columns");
   }
+}
+
+JointRangeCheck::JointRangeCheck(const Model& model) : model_(&model) {
+  const int n = model.nq();
+  for (int i = 1; i <= n; ++i) {
+    const Joint& j = model.joints[static_cast<std::size_t>(i)];
+    const double margin =
+        std::isfinite(j.upper - j.lower) ? std::max(0.1 * (j.upper - j.lower), 0.1) : 0.0;
+    lower_.push_back(j.lower - margin);
+    upper_.push_back(j.upper + margin);
+  }
+  outside_.assign(lower_.size(), 0);
+  furthest_.assign(lower_.size(), 0.0);
+}
+
+void JointRangeCheck::add(const Sample& sample) noexcept {
+  ++rows_;
+  if (static_cast<std::size_t>(sample.q.size()) != lower_.size()) return;
+  for (std::size_t i = 0; i < lower_.size(); ++i) {
+    const double q = sample.q[static_cast<Eigen::Index>(i)];
+    if (q >= lower_[i] && q <= upper_[i]) continue;
+    ++outside_[i];
+    const double beyond = q < lower_[i] ? lower_[i] - q : q - upper_[i];
+    const double before =
+        furthest_[i] < lower_[i] ? lower_[i] - furthest_[i] : furthest_[i] - upper_[i];
+    if (outside_[i] == 1 || beyond > before) furthest_[i] = q;
+  }
+}
+
+std::string JointRangeCheck::note() const {
+  std::size_t worst = lower_.size();
+  for (std::size_t i = 0; i < lower_.size(); ++i) {
+    if (outside_[i] > 0 && (worst == lower_.size() || outside_[i] > outside_[worst])) worst = i;
+  }
+  if (worst == lower_.size()) return {};
+  long joints = 0;
+  for (const long o : outside_) joints += o > 0 ? 1 : 0;
+  const Joint& j = model_->joints[worst + 1];
+  char shown[32];
+  std::snprintf(shown, sizeof shown, "%.4g", furthest_[worst]);
+  return "q" + std::to_string(worst + 1) + " (joint '" + j.name + "') lies outside its limits [" +
+         format_number(j.lower) + ", " + format_number(j.upper) + "] on " +
+         std::to_string(outside_[worst]) + " of " + std::to_string(rows_) + " rows (up to " +
+         std::string(shown) + ")" +
+         (joints > 1 ? ", and " + std::to_string(joints - 1) + " more joint" +
+                           (joints > 2 ? "s" : "") + " too"
+                     : std::string()) +
+         ": are the positions in degrees, or of another robot? The model takes radians (and "
+         "metres), in its joints' order";
 }
 
 }  // namespace extwrench::detail

@@ -3,6 +3,9 @@
 // answer from both.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "extwrench/estimation/base_sensor.hpp"
 #include "extwrench/io/log.hpp"
 
@@ -15,5 +18,22 @@ void check_joint_columns(const LogReader& reader, int n, bool ignore);
 /// The columns the configured base sensor needs (fs_*, and ms_* for an F/T sensor): an error
 /// naming the missing ones.
 void check_sensor_columns(const LogReader& reader, SensorType sensor);
+
+/// Joint positions far outside the model's limits (by more than a tenth of the range, at least
+/// 0.1 rad or m): most often a log in degrees. Fed row by row; note() describes the joint that
+/// strays furthest, "" when none does.
+class JointRangeCheck {
+ public:
+  explicit JointRangeCheck(const Model& model);
+  void add(const Sample& sample) noexcept;
+  [[nodiscard]] std::string note() const;
+
+ private:
+  const Model* model_;
+  std::vector<double> lower_, upper_;  // limits widened by the margin
+  std::vector<long> outside_;          // rows outside, per joint
+  std::vector<double> furthest_;       // the value furthest outside, per joint
+  long rows_ = 0;
+};
 
 }  // namespace extwrench::detail

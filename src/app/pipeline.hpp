@@ -13,6 +13,8 @@
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
+#include <functional>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <thread>
@@ -107,6 +109,14 @@ class BatchRing {
   bool cancelled_ = false;
 };
 
+/// A sample as the pipeline hands it out, with what the row hook computed from it (on the reader's
+/// thread when threaded: work there is off the estimating thread's critical path).
+struct PipelineRow {
+  Sample sample;
+  double derived = std::numeric_limits<double>::quiet_NaN();  // NaN without a hook
+};
+using RowHook = std::function<double(const Sample&)>;
+
 /// The reader and writer threads around the estimator loop (`threaded`), or the plain loop
 /// without them. Rows come out of next() in log order; a malformed row's error comes out after
 /// every row before it, as it would from a plain loop. Estimates go in through push(). The
@@ -114,15 +124,17 @@ class BatchRing {
 /// both threads.
 class Pipeline {
  public:
+  /// row_hook (may be empty: derived NaN) runs once per row read, on the reader's thread.
   Pipeline(LogReader& reader, EstimatesWriter& writer, const Sample& sample_prototype,
-           const ContactEstimate& estimate_prototype, bool threaded) {
+           const ContactEstimate& estimate_prototype, bool threaded, RowHook row_hook = {})
+      : row_hook_(std::move(row_hook)) {
     if (!threaded) {
       reader_ = &reader;
       writer_ = &writer;
-      sample_ = sample_prototype;
+      row_.sample = sample_prototype;
       return;
     }
-    in_.emplace(sample_prototype);
+    in_.emplace(PipelineRow{sample_prototype});
     out_.emplace(estimate_prototype);
     reader_thread_ = std::thread([this, &reader] { read_rows(reader); });
     try {
@@ -141,8 +153,8 @@ class Pipeline {
 
   /// The next sample, valid until the following call; nullptr at the end of the log. Rethrows
   /// the reader's error (a malformed row) at its place in the sequence.
-  const Sample* next() {
-    if (reader_ != nullptr) return reader_->next(sample_) ? &sample_ : nullptr;
+  const PipelineRow* next() {
+    if (reader_ != nullptr) return read_row(*reader_, row_) ? &row_ : nullptr;
     for (;;) {
       if (in_batch_ == nullptr) {
         in_batch_ = in_->acquire_full();  // the reader is only cancelled by our destructor
@@ -180,6 +192,12 @@ class Pipeline {
   }
 
  private:
+  bool read_row(LogReader& reader, PipelineRow& row) const {
+    if (!reader.next(row.sample)) return false;
+    row.derived = row_hook_ ? row_hook_(row.sample) : std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+
   void read_rows(LogReader& reader) {
     give_way_to_the_estimator();
     for (;;) {
@@ -187,7 +205,7 @@ class Pipeline {
       if (b == nullptr) return;  // cancelled: the consumer has stopped
       try {
         while (b->count < kBatchRows) {
-          if (!reader.next(b->items[b->count])) {
+          if (!read_row(reader, b->items[b->count])) {
             b->last = true;
             break;
           }
@@ -246,18 +264,19 @@ class Pipeline {
     reader_thread_.join();
   }
 
-  std::optional<BatchRing<Sample>> in_;  // threaded only
+  RowHook row_hook_;
+  std::optional<BatchRing<PipelineRow>> in_;  // threaded only
   std::optional<BatchRing<ContactEstimate>> out_;
-  typename BatchRing<Sample>::Batch* in_batch_ = nullptr;
+  typename BatchRing<PipelineRow>::Batch* in_batch_ = nullptr;
   std::size_t in_index_ = 0;
   typename BatchRing<ContactEstimate>::Batch* out_batch_ = nullptr;
   std::exception_ptr write_error_;
   std::thread reader_thread_;
   std::thread writer_thread_;
-  // The plain loop (not threaded): reads into sample_, writes directly.
+  // The plain loop (not threaded): reads into row_, writes directly.
   LogReader* reader_ = nullptr;
   EstimatesWriter* writer_ = nullptr;
-  Sample sample_;
+  PipelineRow row_;
 };
 
 }  // namespace extwrench::detail

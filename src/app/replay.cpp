@@ -163,15 +163,21 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   const std::string title = title_of(o);
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
   ContactTally contacts(model.num_bodies());
+  detail::JointRangeCheck joint_range(model);
   const std::string log_name = reader.name();  // the reader belongs to its thread from here on
-  detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype(), o.pipelined);
-  while (const Sample* sample = pipeline.next()) {
-    const Sample& s = *sample;
+  // cond(J) of the true link, for the figures, on the reader's thread when there is one.
+  detail::RowHook true_condition;
+  if (figures && layout.truth) true_condition = figures->true_condition();
+  detail::Pipeline pipeline(reader, writer, Sample{}, estimator.prototype(), o.pipelined,
+                            std::move(true_condition));
+  while (const detail::PipelineRow* row = pipeline.next()) {
+    const Sample& s = row->sample;
     const ContactEstimate& e = estimator.update(s);
     pipeline.push(e);
     contacts.add(s.t, e.contact, e.link, e.has(EstimateFlag::kDisagreement));
+    joint_range.add(s);
     if (layout.truth) metrics.add(s, e);
-    if (figures) figures->add(s, e, estimator.detector());
+    if (figures) figures->add(s, e, estimator.detector(), row->derived);
     progress.update(contacts.rows, "%s: replayed %ld rows (t = %.1f s)", title.c_str(),
                     contacts.rows, s.t);
   }
@@ -203,6 +209,8 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     const std::string warning = disagreement_warning(result.contacts);
     if (!warning.empty())
       messages_of(o) << "extwrench: warning: " << title << ": " << warning << "\n";
+    const std::string base = base_contact_warning(result.contacts, model);
+    if (!base.empty()) messages_of(o) << "extwrench: warning: " << title << ": " << base << "\n";
   }
   if (o.note_frequent_alarms && !result.has_truth) {
     const std::string note = frequent_alarms_note(result.contacts);
@@ -210,6 +218,10 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   }
   if (const std::string note = time_step_note(result.contacts); !note.empty())
     messages_of(o) << "extwrench: note: " << title << ": " << note << "\n";
+  if (const std::string note = time_gap_note(result.contacts); !note.empty())
+    messages_of(o) << "extwrench: note: " << title << ": " << note << "\n";
+  if (const std::string range = joint_range.note(); !range.empty())
+    messages_of(o) << "extwrench: warning: " << title << ": " << range << "\n";
   own_outputs.keep();
   return result;
 }

@@ -1,10 +1,12 @@
 #include "extwrench/io/log.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
 
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/nearest_name.hpp"
 #include "extwrench/io/number_text.hpp"
 
 namespace extwrench {
@@ -49,13 +51,36 @@ LogReader::LogReader(const std::filesystem::path& path, const Model& model)
   const int n = model.nq();
   layout_.n = n;
   std::set<int> known;
+  // What a user sees of their own header when a name is missing: a near miss, then the names.
+  const auto near_miss = [&](const std::string& name) {
+    // Among the names the format does not know (q1 is no typo of q3).
+    const std::vector<std::string> known_names =
+        log_columns(LogLayout{n, true, true, true, true, true});
+    std::vector<std::string> unknown;
+    for (const std::string& h : csv_.header()) {
+      if (std::find(known_names.begin(), known_names.end(), h) == known_names.end())
+        unknown.push_back(h);
+    }
+    const std::string nearest = nearest_name(name, unknown);
+    return nearest.empty() ? std::string() : "; the header has '" + nearest + "'";
+  };
+  const auto header_list = [&] {
+    if (!csv_.separator_hint().empty()) return std::string();  // one long name: the hint says it
+    constexpr std::size_t kShown = 16;
+    const std::vector<std::string>& h = csv_.header();
+    std::string list;
+    for (std::size_t i = 0; i < std::min(h.size(), kShown); ++i) list += (i ? ", " : "") + h[i];
+    if (h.size() > kShown) list += ", ... (" + std::to_string(h.size()) + " columns)";
+    return ". Its header: " + list;
+  };
   auto required = [&](const std::string& name) {
     const auto c = csv_.find_column(name);
     if (!c) {
-      throw Error(csv_.name() + ":1: missing column '" + name + "' (robot '" + model.name +
-                  "' has " + std::to_string(n) + " joints: the log needs t, q1..q" +
-                  std::to_string(n) + ", tau1..tau" + std::to_string(n) +
-                  "; see docs/log_format.md)" + csv_.separator_hint());
+      throw Error(csv_.name() + ":1: missing column '" + name + "'" + near_miss(name) +
+                  " (robot '" + model.name + "' has " + std::to_string(n) +
+                  " joints: the log needs t, q1..q" + std::to_string(n) + ", tau1..tau" +
+                  std::to_string(n) + "; see docs/log_format.md)" + csv_.separator_hint() +
+                  header_list());
     }
     known.insert(*c);
     return *c;

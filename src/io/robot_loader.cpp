@@ -70,7 +70,10 @@ RobotDescription load_robot(const std::filesystem::path& path, const LoadOptions
   }
   throw Error(
       path.string() + ": unknown robot file type '" + ext +
-      "' (expected .urdf or .xml for URDF, .yaml or .yml for a DH table, .xml or .mjcf for MJCF)");
+      "' (expected .urdf or .xml for URDF, .yaml or .yml for a DH table, .xml or .mjcf for MJCF)" +
+      (ext == ".xacro" ? std::string("; a xacro file must be expanded into a URDF first (ROS's "
+                                     "xacro: `xacro robot.urdf.xacro > robot.urdf`)")
+                       : std::string()));
 }
 
 }  // namespace extwrench

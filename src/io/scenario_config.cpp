@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -82,10 +83,22 @@ sim::ForceProfile parse_force(const YamlReader& y, const YAML::Node& node, const
   if (node["force"]) f.force = y.vector3(node["force"], k + ".force");
   if (node["moment"]) f.moment = y.vector3(node["moment"], k + ".moment");
   if (node["point"]) f.point_F = y.vector3(node["point"], k + ".point");
-  if (node["start"]) f.start = y.number(node["start"], k + ".start");
+  if (node["start"]) f.start = y.number_in(node["start"], k + ".start", non_negative());
   if (node["end"]) f.end = y.number(node["end"], k + ".end");
   if (node["ramp"]) f.ramp = y.number_in(node["ramp"], k + ".ramp", non_negative());
   if (!(f.end > f.start)) y.fail(node, k, "end must be after start");
+  // The force ramps up over `ramp` s from start and down over `ramp` s before end: a longer ramp
+  // than half the window would cap it below the force given, silently.
+  if (f.ramp > 0.5 * (f.end - f.start)) {
+    y.fail(node["ramp"], k + ".ramp",
+           "a ramp of " + format_number(f.ramp) +
+               " s up and as long down does not fit between start " + format_number(f.start) +
+               " and end " + format_number(f.end) +
+               " s: the force would never reach its value (at most half the window, " +
+               format_number(0.5 * (f.end - f.start)) + " s)");
+  }
+  if (f.force.isZero(0.0) && f.moment.isZero(0.0))
+    y.fail(node, k, "force and moment are both zero (give force: [fx, fy, fz] in N, or moment)");
   return f;
 }
 
@@ -112,6 +125,19 @@ void parse_encoder(const YamlReader& y, const YAML::Node& e, sim::EncoderModel& 
         y.one_of(e["velocity"], "sensors.encoder.velocity", {"exact", "differentiate"}) == 1;
   }
   y.set_number_in(e, "sensors.encoder", "velocity_cutoff", non_negative(), encoder.velocity_cutoff);
+  // The step of a quantised position, not a bit count: a 19-bit encoder's is 2π/2¹⁹ ≈ 1.2e-5.
+  if (encoder.resolution > 0.1) {
+    y.fail(e["resolution"], "sensors.encoder.resolution",
+           format_number(encoder.resolution) +
+               " is larger than any encoder's step (rad or m per count; a 19-bit encoder's is "
+               "2*pi/2^19 = 1.2e-5 rad): give the step, not the number of bits");
+  }
+  // The low-pass filters the differentiated q̇ only: with exact q̇ it would change nothing.
+  if (encoder.velocity_cutoff > 0.0 && !encoder.differentiate) {
+    y.fail(e["velocity_cutoff"], "sensors.encoder.velocity_cutoff",
+           "filters the differentiated velocity only: set 'velocity: differentiate' (q̇ is "
+           "exact here), or remove velocity_cutoff");
+  }
 }
 
 // sensors.joint_torque: {friction: the configuration's friction mapping, noise}.
@@ -565,6 +591,14 @@ std::string scheme_config_yaml(const Scenario& s, const SchemeSpec& scheme) {
   out["gravity"] = YAML::Load("[" + format_number(g.x()) + ", " + format_number(g.y()) + ", " +
                               format_number(g.z()) + "]");
   for (const auto& kv : node) out[kv.first.Scalar()] = kv.second;
+  // The scheme is written into DIR/<scheme>/ (or DIR/seed_<k>/<scheme>/): a calibration file
+  // given relative to the scenario, as a user writes it, is written as an absolute path.
+  if (const YAML::Node c = out["calibration"]; c && c.IsScalar()) {
+    const std::filesystem::path rel(c.Scalar());
+    if (!rel.empty() && rel.is_relative())
+      out["calibration"] =
+          std::filesystem::absolute(s.source.parent_path() / rel).lexically_normal().string();
+  }
   if (!out["sensor"].IsMap()) throw Error(label + ": sensor: expected a mapping (type: ...)");
   if (out["sensor"]["type"].Scalar() != "none" && !out["sensor"]["pose"]) {
     out["sensor"]["pose"] = YAML::Load(pose_yaml(s.simulation.sensor.X_WS));

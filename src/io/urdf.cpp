@@ -76,6 +76,16 @@ class UrdfParser {
     }
     ModelBuilder builder;
     if (const char* name = robot->Attribute("name")) builder.set_name(name);
+    // A .urdf.xacro given as it is: its macros would be skipped as extensions, and the robot
+    // they make (a gripper, a whole arm) silently left out.
+    for (const XMLElement* e = robot->FirstChildElement(); e != nullptr;
+         e = e->NextSiblingElement()) {
+      if (std::strncmp(e->Name(), "xacro:", 6) == 0) {
+        throw Error(where(e) + ": <" + shown(e->Name()) +
+                    ">: a xacro macro, which a URDF cannot hold: expand the file first (ROS's "
+                    "xacro: `xacro robot.urdf.xacro > robot.urdf`) and load the result");
+      }
+    }
     if (robot->FirstChildElement("link") == nullptr) {
       const char* name = robot->Attribute("name");
       throw Error(where(robot) + ": <robot" + (name ? " '" + shown(name) + "'" : std::string()) +

@@ -180,7 +180,12 @@ struct BadLog {
 
 TEST_F(Replay, MalformedLogsAreErrorsNamingLineAndColumn) {
   const std::vector<BadLog> cases = {
-      {"missing_q3", "t,q1,q2,q4\n0,1,2,3\n", ":1: missing column 'q3'"},
+      {"missing_q3", "t,q1,q2,q4\n0,1,2,3\n",
+       ":1: missing column 'q3' (robot 'paper_arm' has 7 joints"},
+      // A near miss among the names the format does not know, and the header as it is.
+      {"typo_tua4", header(false).replace(header(false).find("tau4"), 4, "tua4") + row(0, 14),
+       ":1: missing column 'tau4'; the header has 'tua4' (robot"},
+      {"header_listed", "time,q1\n0,1\n", ". Its header: time, q1"},
       {"missing_tau7", header(true).substr(0, header(true).size() - 6) + "\n" + row(0, 20),
        "missing column 'tau7'"},
       {"partial_dq", "t,q1,q2,q3,q4,q5,q6,q7,dq1,tau1,tau2,tau3,tau4,tau5,tau6,tau7\n",
@@ -305,6 +310,19 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        "forces[0].force: expected a list of 3 numbers"},
       {"end_before_start", replace(kGoodScenario, "start: 0.1", "start: 0.1, end: 0.05"),
        "end must be after start"},
+      // Found by a review: each ran, and its force was not the one written.
+      {"ramp_too_long", replace(kGoodScenario, "start: 0.1", "start: 0.1, end: 0.3, ramp: 0.15"),
+       "forces[0].ramp: a ramp of 0.15 s up and as long down does not fit between start 0.1 and "
+       "end 0.3 s"},
+      {"zero_force", replace(kGoodScenario, "force: [20, 0, 0]", "force: [0, 0, 0]"),
+       "forces[0]: force and moment are both zero"},
+      {"negative_start", replace(kGoodScenario, "start: 0.1", "start: -0.1"),
+       "forces[0].start: expected a value >= 0, got -0.1"},
+      {"encoder_bits", kGoodScenario + "sensors: {encoder: {resolution: 19}}\n",
+       ":9: sensors.encoder.resolution: 19 is larger than any encoder's step"},
+      {"cutoff_of_exact_velocity",
+       kGoodScenario + "sensors: {encoder: {velocity: exact, velocity_cutoff: 5}}\n",
+       ":9: sensors.encoder.velocity_cutoff: filters the differentiated velocity only"},
       {"model_error", kGoodScenario + "model_error: 0.7\n",
        "model_error: expected a fraction in [0, 0.5)"},
       {"sensor_type", kGoodScenario + "sensors: {base: {type: laser}}\n",
@@ -315,6 +333,7 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        "seeds[0]: expected a whole number >= 0, got 1.5"},
       {"exclude_reversed", kGoodScenario + "metrics: {exclude: [[2, 1]]}\n",
        "metrics.exclude[0]: expected [from, to] with from < to"},
+
       {"scheme_robot", replace(kGoodScenario, "ft: {sensor", "ft: {robot: x.urdf, sensor"),
        "schemes.ft.robot: schemes use the scenario's perturbed model"},
       {"scheme_without_sensor", replace(kGoodScenario, "ft: {sensor: {type: ft}, ", "ft: {"),
@@ -409,6 +428,19 @@ TEST_F(Replay, SchemeWithABadEstimatorKeyFailsBeforeSimulatingAndNamesTheScheme)
   EXPECT_NE(what.find("scheme 'ft'"), std::string::npos) << what;
   EXPECT_NE(what.find("contact.model"), std::string::npos) << what;
   EXPECT_FALSE(fs::exists(dir / "out" / "log.csv"));
+}
+
+// A scheme's calibration file relative to the scenario, as a user writes it, is found from the
+// scheme's own directory (DIR/<scheme>/ or DIR/seed_<k>/<scheme>/) where its config.yaml goes.
+TEST_F(Replay, SchemeCalibrationRelativeToTheScenarioIsWrittenAsAnAbsolutePath) {
+  const fs::path dir = temp_dir("scheme_calibration");
+  write_text(dir / "s.yaml", replace(kGoodScenario, "ft: {sensor: {type: ft}, ",
+                                     "ft: {calibration: calib/c.yaml, sensor: {type: ft}, "));
+  const Scenario s = load_scenario(dir / "s.yaml");
+  ASSERT_EQ(s.schemes.size(), 1u);
+  const std::string config = scheme_config_yaml(s, s.schemes[0]);
+  const fs::path expected = (fs::absolute(dir) / "calib" / "c.yaml").lexically_normal();
+  EXPECT_NE(config.find("calibration: " + expected.string() + "\n"), std::string::npos) << config;
 }
 
 // ---- URDF writer ----------------------------------------------------------------------------
@@ -739,6 +771,54 @@ TEST(TimeStepNote, NamesSecondsForSamplesMoreThan50msApart) {
   EXPECT_EQ(time_step_note(tally(1000, 0.001)), "");  // 1 kHz
   EXPECT_EQ(time_step_note(tally(1, 1.0)), "");       // one sample: no step
   EXPECT_EQ(time_step_note(ContactTally(8)), "");
+}
+
+// A log with a hole in it (a 1 s gap in a 1 kHz log, the review's) is noted with the times; a
+// steady log, a slow one and jitter are not.
+TEST(TimeGapNote, NamesTheLongestStepWhenItIsAGap) {
+  const auto tally = [](long rows, double step, long gap_after, double gap) {
+    ContactTally t(8);
+    double time = 0.0;
+    for (long k = 0; k < rows; ++k) {
+      t.add(time, false, -1, false);
+      time += step + (k == gap_after ? gap : 0.0);
+    }
+    return t;
+  };
+  const std::string note = time_gap_note(tally(12001, 0.001, 5000, 1.0));
+  EXPECT_NE(note.find("the log has a gap: 1.001 s between t = 5 and 6.001 s"), std::string::npos)
+      << note;
+  EXPECT_EQ(time_gap_note(tally(12001, 0.001, -1, 0.0)), "");     // steady
+  EXPECT_EQ(time_gap_note(tally(12001, 0.001, 5000, 0.02)), "");  // a 21 ms hiccup
+  EXPECT_EQ(time_gap_note(tally(100, 0.1, 50, 0.5)), "");         // 10 Hz: 0.6 s is 6 steps
+  EXPECT_EQ(time_gap_note(tally(2, 1.0, 0, 5.0)), "");            // too short to tell
+}
+
+// Contacts mostly on link 0 alone (a base sensor read with flipped signs, a wrong pose or bias)
+// are warned about, naming the sensor's convention, pose and bias; a push on a link is not.
+TEST(BaseContactWarning, NamesTheSensorWhenMostContactsAreOnTheBase) {
+  Model model;
+  for (const char* name : {"panda_link0", "panda_link1", "panda_link2"}) {
+    Body body;
+    body.name = name;
+    model.bodies.push_back(body);
+  }
+  const auto tally = [&](long on_base, long on_link) {
+    ContactTally t(model.num_bodies());
+    long k = 0;
+    for (long i = 0; i < on_base; ++i) t.add(0.001 * static_cast<double>(k++), true, 0, false);
+    for (long i = 0; i < on_link; ++i) t.add(0.001 * static_cast<double>(k++), true, 2, false);
+    return t;
+  };
+  const std::string warning = base_contact_warning(tally(11995, 0), model);
+  EXPECT_NE(warning.find("100 % of the 11995 contact samples are on the base (panda_link0"),
+            std::string::npos)
+      << warning;
+  for (const char* word : {"sign convention", "sensor.pose", "sensor.tare"})
+    EXPECT_NE(warning.find(word), std::string::npos) << word;
+  EXPECT_NE(base_contact_warning(tally(60, 40), model), "");
+  EXPECT_EQ(base_contact_warning(tally(40, 60), model), "");  // mostly a link
+  EXPECT_EQ(base_contact_warning(tally(19, 0), model), "");   // a tap on the base
 }
 
 // The tally behind `estimate`'s line, by hand: a contact on the first sample is an episode, a

@@ -3,6 +3,7 @@
 // every algorithm checked against another path (finite differences, RNEA columns, Newton's law).
 #include <gtest/gtest.h>
 
+#include <Eigen/SVD>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -451,6 +452,38 @@ TEST_P(DynamicsIdentities, StaticRobotDischargesItsWeightAndItsMoment) {
     EXPECT_LE((reading.head<3>() - weight).norm(), 1e-12 * weight.norm());
     EXPECT_LE((reading.tail<3>() - (mc / m - p_WS).cross(weight)).norm(), 1e-12 * weight.norm());
   }
+}
+
+// The condition number of Fig. 10, against the SVD of the same columns computed here: for every
+// body of random chains (l < 6 takes the Gram matrix Jᵀ J, l ≥ 6 J Jᵀ), and at the stretched
+// paper arm's singularity (κ far above 1e6, where the SVD is used).
+TEST(JacobianCondition, EqualsTheRatioOfTheSingularValues) {
+  SeededRng rng(31);
+  for (const int n : {3, 5, 7, 9}) {
+    const Model model = random_chain({n, false, false, static_cast<std::uint64_t>(40 + n)});
+    Data data(model);
+    Matrix6X J(6, n);
+    for (int k = 0; k < 50; ++k) {
+      forward_poses(model, data, rng.uniform_vector(n, -3, 3));
+      for (int body = 1; body <= n; ++body) {
+        point_jacobian(model, data, body, data.X_WB[body].translation, J);
+        const Eigen::JacobiSVD<MatrixX> svd(J.leftCols(body));
+        const auto& s = svd.singularValues();
+        const double expected = s[0] / s[s.size() - 1];
+        const double got = jacobian_condition(model, data, body);
+        if (expected < 1e6) {
+          EXPECT_NEAR(got, expected, 1e-8 * expected) << "n " << n << " body " << body;
+        } else {
+          EXPECT_GT(got, 1e5) << "n " << n << " body " << body;
+        }
+      }
+    }
+  }
+  const Model arm = paper_arm();
+  Data data(arm);
+  forward_poses(arm, data, VectorX::Zero(arm.nq()));
+  EXPECT_GT(jacobian_condition(arm, data, arm.nq()), 1e6);
+  EXPECT_TRUE(std::isnan(jacobian_condition(arm, data, 0)));
 }
 
 INSTANTIATE_TEST_SUITE_P(RandomModels, DynamicsIdentities,

@@ -220,20 +220,30 @@ TEST_F(Cli, CalibrateRefusesTheOtherSignsScale) {
                        "is it in mrad or degrees?"));
 }
 
-// A push that starts after the run: noted, and the table's worst row shows no line error or
-// link accuracy it never measured (it said 0.0000 m and 100.00 %).
+// A push that starts after the run, and metrics windows beside it: noted, and the table's worst row
+// shows no line error or link accuracy it never measured (it said 0.0000 m and 100.00 %).
 TEST_F(Cli, SimulateNotesAPushAfterTheEndAndInventsNoWorstValues) {
   write_text(path("late.yaml"),
              "robot: " + (kModels / "paper_arm.urdf").string() +
                  "\nseeds: [1, 2]\nduration: 0.3\ntrajectory: {offset: 0.3, amplitude: 0.2, "
                  "frequency: 0.5, phase: 0}\nforces:\n  - {frame: link6, axes: frame, force: [20, "
-                 "0, 0], point: [0, 0, 0.1], start: 5}\nschemes:\n  ft: {sensor: {type: ft}}\n");
+                 "0, 0], point: [0, 0, 0.1], start: 5}\nschemes:\n  ft: {sensor: {type: ft}}\n"
+                 "metrics: {from: 0.3, exclude: [[10, 20]]}\n");
   const RunResult r = run("simulate --no-figures '" + path("late.yaml").string() + "' --out '" +
                           path("late").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err << r.out;
   EXPECT_TRUE(contains(r.err,
                        "note: forces[0] starts at t = 5 s, after the run's end (duration "
                        "0.3 s): it never acts"));
+  // So are metrics windows beside the run (a table of dashes read as a failed run).
+  EXPECT_TRUE(contains(r.err,
+                       "note: metrics.from is 0.3 s, at or after the run's end (duration 0.3 s): "
+                       "no sample is measured, every metric is empty"))
+      << r.err;
+  EXPECT_TRUE(contains(r.err,
+                       "note: metrics.exclude[0] [10, 20] s lies outside the run (0 to 0.3 s): it "
+                       "excludes nothing"))
+      << r.err;
   const auto at = r.out.find("\nft            worst");
   ASSERT_NE(at, std::string::npos) << r.out;
   const std::string worst = r.out.substr(at + 1, r.out.find('\n', at + 1) - at - 1);

@@ -76,6 +76,19 @@ TEST_F(CliLock, EstimateOnATreeSaysWhichJointsToLock) {
   const RunResult locked = run(common + " --lock finger_slide=0.01 --lock finger_hinge=0");
   // The configuration now loads; the log (4 joints for a 2-joint chain) is what fails next.
   EXPECT_EQ(locked.err.find("not a serial chain"), std::string::npos) << locked.err;
+  // calibrate says the same and takes --lock too (it said to, then refused the option).
+  const std::string calibrate = "calibrate --config '" + (dir_ / "config.yaml").string() +
+                                "' --log '" + (dir_ / "log.csv").string() + "' --out '" +
+                                (dir_ / "calib.yaml").string() + "'";
+  const RunResult calibrate_tree = run(calibrate);
+  EXPECT_EQ(calibrate_tree.code, 1);
+  EXPECT_NE(calibrate_tree.err.find("--lock NAME=VALUE"), std::string::npos) << calibrate_tree.err;
+  const RunResult calibrate_locked =
+      run(calibrate + " --lock finger_slide=0.01 --lock finger_hinge=0");
+  EXPECT_EQ(calibrate_locked.code, 1) << calibrate_locked.err;  // the log, as above
+  EXPECT_EQ(calibrate_locked.err.find("not a serial chain"), std::string::npos)
+      << calibrate_locked.err;
+  EXPECT_NE(calibrate_locked.err.find("log.csv"), std::string::npos) << calibrate_locked.err;
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -405,6 +406,70 @@ TEST_F(RealLog, JointColumnsBeyondTheRobotAreAnErrorUnlessIgnoredOnPurpose) {
       estimate(cfg, "extra_ignored", "--no-figures --ignore-extra-joints", "eight_joints.csv");
   EXPECT_EQ(ignored.code, 0) << ignored.err;
   EXPECT_TRUE(fs::exists(dir_ / "extra_ignored/estimates.csv"));
+}
+
+// The robot log with each cell of the columns whose name starts with one of `prefixes` changed
+// by `change`, and the rows with from <= t < to dropped.
+std::string edited_log(const std::string& log, const std::vector<std::string>& prefixes,
+                       const std::function<double(double)>& change, double from = 1.0,
+                       double to = 0.0) {
+  std::istringstream in(log);
+  std::string line, text;
+  std::getline(in, line);
+  text = line + "\n";
+  std::vector<bool> edit;
+  for (std::istringstream h(line); std::getline(h, line, ',');) {
+    bool e = false;
+    for (const std::string& p : prefixes) e = e || line.rfind(p, 0) == 0;
+    edit.push_back(e);
+  }
+  while (std::getline(in, line)) {
+    std::istringstream cells(line);
+    std::string cell, row;
+    bool dropped = false;
+    for (std::size_t c = 0; std::getline(cells, cell, ','); ++c) {
+      if (c == 0 && std::stod(cell) >= from && std::stod(cell) < to) dropped = true;
+      char number[32];
+      if (edit.at(c)) std::snprintf(number, sizeof number, "%.17g", change(std::stod(cell)));
+      row += (c ? "," : "") + (edit.at(c) ? std::string(number) : cell);
+    }
+    if (!dropped) text += row + "\n";
+  }
+  return text;
+}
+
+// What a review found a first log of one's own robot does unnoticed: positions in degrees (the
+// estimates meaningless, calibrate's thresholds 10 000 N m), a base sensor read with the other
+// sign convention (unit-tested: BaseContactWarning), a gap in t.
+TEST_F(RealLog, PositionsInDegreesAndAGapInTimeAreSaid) {
+  const std::string log = read_text(dir_ / "robot_log.csv");
+  write_text(dir_ / "degrees.csv",
+             edited_log(log, {"q"}, [](double q) { return q * 180.0 / 3.141592653589793; }));
+  const fs::path none = config("cfg_units", "{type: none}", "no_sensor");
+  const CliRun degrees = estimate(none, "degrees", "--no-figures", "degrees.csv");
+  ASSERT_EQ(degrees.code, 0) << degrees.err;  // a warning: the user may know better
+  EXPECT_TRUE(contains(degrees.err, "warning: ")) << degrees.err;
+  EXPECT_TRUE(contains(degrees.err, "lies outside its limits")) << degrees.err;
+  EXPECT_TRUE(contains(degrees.err, "are the positions in degrees")) << degrees.err;
+  const CliRun calibrate =
+      run("calibrate --config '" + none.string() + "' --log '" + (dir_ / "degrees.csv").string() +
+          "' --out '" + (dir_ / "degrees_calib.yaml").string() + "'");
+  EXPECT_EQ(calibrate.code, 1);
+  EXPECT_TRUE(contains(calibrate.err, "are the positions in degrees")) << calibrate.err;
+  EXPECT_FALSE(fs::exists(dir_ / "degrees_calib.yaml"));
+  // In radians, as simulated: no word of it.
+  const CliRun radians = estimate(none, "radians", "--no-figures");
+  EXPECT_FALSE(contains(radians.err, "outside its limits")) << radians.err;
+  EXPECT_FALSE(contains(radians.err, "gap")) << radians.err;
+  EXPECT_FALSE(contains(radians.err, "on the base")) << radians.err;
+
+  write_text(dir_ / "gap.csv", edited_log(
+                                   log, {}, [](double v) { return v; }, 1.0, 1.5));
+  const CliRun gap = estimate(none, "gap", "--no-figures", "gap.csv");
+  ASSERT_EQ(gap.code, 0) << gap.err;
+  EXPECT_TRUE(
+      contains(gap.err, "note: cfg_units: the log has a gap: 0.501 s between t = 0.999 and 1.5 s"))
+      << gap.err;
 }
 
 TEST_F(RealLog, AFigureThatCannotBeDrawnIsAWarningAndLeavesNoPartialFile) {

@@ -250,6 +250,7 @@ TEST_P(NewUser, InfoDynamicsSimulateAndEstimateOnALogWithoutTruthGiveNoSilentWro
   EXPECT_TRUE(is_png(sim / "summary.png"));
   // The scenarios set no singularity window: its columns say so instead of showing zeros.
   EXPECT_FALSE(contains(s.out, "excludes ±0 s")) << s.out;
+  EXPECT_FALSE(contains(read_text(sim / "summary.gp"), "outside singularity"));  // nor its legend
   std::istringstream table(s.out);
   for (std::string line; std::getline(table, line);) {
     std::istringstream words(line);

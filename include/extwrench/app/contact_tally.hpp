@@ -21,6 +21,8 @@ struct ContactTally {
   std::vector<long> samples_by_link;
   double t_begin = 0.0;  ///< the first and last sample's time [s]
   double t_end = 0.0;
+  double longest_step = 0.0;     ///< the longest time step between two samples [s]
+  double longest_step_at = 0.0;  ///< the time of the sample that ends it [s]
 
   ContactTally() = default;
   /// For a robot of `bodies` bodies (Model::num_bodies(), n + 1).
@@ -47,6 +49,11 @@ struct ContactTally {
 /// nothing to warn about (fewer than half, or too few contact samples).
 [[nodiscard]] std::string disagreement_warning(const ContactTally& tally);
 
+/// The warning for estimates whose contacts lie mostly on link 0 (at least 20 contact samples,
+/// more than half of them): the base sensor reads a wrench the robot's motion does not explain
+/// while the joint residual stays quiet. Over a log that is a sensor whose sign convention, pose
+/// or bias is wrong more often than a push on the base; the warning names both. Empty otherwise.
+[[nodiscard]] std::string base_contact_warning(const ContactTally& tally, const Model& model);
 /// The note for estimates whose contacts look like a model's error rather than a touch: declared
 /// anew at least once a second (10 times or more), or on 80 % of the samples or more, spread
 /// over three links or more (each with 2 % of the contact samples); with the remedy (calibrate
@@ -59,5 +66,8 @@ struct ContactTally {
 /// a sample counter), and the observer and the filters, which integrate over the time steps,
 /// estimate nothing useful. Empty otherwise (and below two samples).
 [[nodiscard]] std::string time_step_note(const ContactTally& tally);
+/// The note for a gap in a log: one time step over 50 ms and 20 times the mean step, which the
+/// observer integrates as one step (its momentum jumps). Empty otherwise.
+[[nodiscard]] std::string time_gap_note(const ContactTally& tally);
 
 }  // namespace extwrench
