@@ -48,8 +48,10 @@ void run_dynamics(const DynamicsOptions& opt) {
   const std::filesystem::path out_path(opt.out);
   if (opt.out != "-") check_output_file(out_path, "--out", {opt.robot, opt.in});
 
-  const RobotDescription robot =
-      load_robot_file(opt.robot, robot_load_options(opt.package_path, opt.lock));
+  // Inverse dynamics needs no geometry: a mesh that cannot be found (package://) is no error here.
+  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  load.load_meshes = false;
+  const RobotDescription robot = load_robot_file(opt.robot, load);
   const Model& model = robot.model;
   const int n = model.nq();
   std::string which = "--sensor-pose";

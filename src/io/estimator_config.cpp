@@ -22,11 +22,40 @@ using io_detail::YamlReader;
 
 constexpr int kDefaultTareSamples = 100;
 
-void read_sensor(const YamlReader& rd, const YAML::Node& sensor, SensorOptions& o) {
-  rd.only_keys(sensor, "sensor", {"type", "pose", "tare", "bias"});
+// sensor.frame: a frame of the model fixed to the root link (a URDF's `ft_sensor_link`), whose
+// placement is X_WS; the frames that qualify are listed when the name is not one of them.
+Pose sensor_frame_pose(const YamlReader& rd, const YAML::Node& node, const Model& model) {
+  const std::string name = rd.string(node, "sensor.frame");
+  std::string fixed;
+  for (const Frame& f : model.frames)
+    if (f.body == 0) fixed += (fixed.empty() ? "" : ", ") + f.name;
+  const auto frame = model.find_frame(name);
+  if (!frame) {
+    rd.fail(node, "sensor.frame",
+            "'" + name + "' is not a frame of robot '" + model.name +
+                "' (frames on the root link '" + model.bodies[0].name +
+                "': " + (fixed.empty() ? "none" : fixed) + ")");
+  }
+  const Frame& f = model.frames[static_cast<std::size_t>(*frame)];
+  if (f.body != 0) {
+    rd.fail(node, "sensor.frame",
+            "'" + name + "' is on the moving link '" +
+                model.bodies[static_cast<std::size_t>(f.body)].name +
+                "': a base sensor is under the root link (frames on it: " +
+                (fixed.empty() ? "none" : fixed) + ")");
+  }
+  return f.placement;
+}
+
+void read_sensor(const YamlReader& rd, const YAML::Node& sensor, const Model& model,
+                 SensorOptions& o) {
+  rd.only_keys(sensor, "sensor", {"type", "pose", "frame", "tare", "bias"});
   if (!sensor["type"]) rd.fail(sensor, "sensor.type", "missing (ft | force | none)");
   o.type = rd.sensor_type(sensor["type"], "sensor.type");
+  if (sensor["pose"] && sensor["frame"])
+    rd.fail(sensor["frame"], "sensor.frame", "give either sensor.pose or sensor.frame, not both");
   if (sensor["pose"]) o.X_WS = rd.pose(sensor["pose"], "sensor.pose");
+  if (sensor["frame"]) o.X_WS = sensor_frame_pose(rd, sensor["frame"], model);
   if (sensor["bias"]) o.bias_S = rd.vector(sensor["bias"], "sensor.bias", 6);
   if (const YAML::Node t = sensor["tare"]) {
     if (YamlReader::is_boolean(t)) {
@@ -346,11 +375,13 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   EstimatorOptions& o = cfg.options;
   if (!root["sensor"])
     rd.fail(root, "sensor", "missing (needs at least sensor.type: ft | force | none)");
-  read_sensor(rd, root["sensor"], o.sensor);
+  read_sensor(rd, root["sensor"], model, o.sensor);
   // One rule everywhere (dynamics, simulate): without sensor.pose in the file, the model's 'sensor'
   // frame.
   if (root["sensor"]["pose"]) {
     cfg.sensor_pose_source = "sensor.pose";
+  } else if (root["sensor"]["frame"]) {
+    cfg.sensor_pose_source = "sensor.frame '" + root["sensor"]["frame"].Scalar() + "'";
   } else {
     o.sensor.X_WS = default_sensor_pose(model);
     cfg.sensor_pose_source = describe_default_sensor_pose(model);

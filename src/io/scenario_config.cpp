@@ -344,6 +344,19 @@ void parse_schemes(const YamlReader& y, const YAML::Node& root, Scenario& s) {
     if (!sensor || !sensor["type"]) {
       y.fail(kv.second, k + ".sensor.type", "missing (ft, force or none)");
     }
+    // The scheme replays the simulated log: its sensor must be one the simulation measures (else
+    // it failed after the whole simulation, on a column of a generated file).
+    const SensorType wanted = y.sensor_type(sensor["type"], k + ".sensor.type");
+    const SensorType measured = s.simulation.sensor.type;
+    if ((wanted == SensorType::kForceTorque && measured != SensorType::kForceTorque) ||
+        (wanted == SensorType::kForce && measured == SensorType::kNone)) {
+      y.fail(sensor["type"], k + ".sensor.type",
+             std::string("the scheme reads a base ") +
+                 (wanted == SensorType::kForceTorque ? "F/T sensor" : "force sensor") +
+                 " that the simulation does not measure: sensors.base.type is '" +
+                 (measured == SensorType::kNone ? "none" : "force") +
+                 "' (default ft; give the scheme that sensor, or the simulation this one)");
+    }
     // Kept as text and read back when the scheme's config.yaml is written: text that does not
     // read back (a key with control bytes) is refused here, with its line, not there.
     YAML::Emitter out;
@@ -600,7 +613,8 @@ std::string scheme_config_yaml(const Scenario& s, const SchemeSpec& scheme) {
           std::filesystem::absolute(s.source.parent_path() / rel).lexically_normal().string();
   }
   if (!out["sensor"].IsMap()) throw Error(label + ": sensor: expected a mapping (type: ...)");
-  if (out["sensor"]["type"].Scalar() != "none" && !out["sensor"]["pose"]) {
+  if (out["sensor"]["type"].Scalar() != "none" && !out["sensor"]["pose"] &&
+      !out["sensor"]["frame"]) {
     out["sensor"]["pose"] = YAML::Load(pose_yaml(s.simulation.sensor.X_WS));
   }
   YAML::Emitter e;

@@ -318,6 +318,14 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        "forces[0]: force and moment are both zero"},
       {"negative_start", replace(kGoodScenario, "start: 0.1", "start: -0.1"),
        "forces[0].start: expected a value >= 0, got -0.1"},
+      // A sweep written with YAML merge keys, which yaml-cpp reads as a key named "<<".
+      {"merge_key",
+       replace(kGoodScenario, "ft: {sensor: {type: ft}, contact: {model: pure_force}}",
+               "ft: &base {sensor: {type: ft}, contact: {model: pure_force}}\n  k2: {<<: *base}"),
+       ":9: schemes.k2.<<: YAML merge keys (<<: *anchor) are not supported"},
+      {"scheme_sensor_not_simulated", kGoodScenario + "sensors: {base: {type: none}}\n",
+       ":8: schemes.ft.sensor.type: the scheme reads a base F/T sensor that the simulation does "
+       "not measure: sensors.base.type is 'none'"},
       {"encoder_bits", kGoodScenario + "sensors: {encoder: {resolution: 19}}\n",
        ":9: sensors.encoder.resolution: 19 is larger than any encoder's step"},
       {"cutoff_of_exact_velocity",

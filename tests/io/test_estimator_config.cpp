@@ -107,6 +107,21 @@ TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {
   EXPECT_TRUE(c.robot.model.gravity.isApprox(Vector3(0, 0, -9.81)));
 }
 
+// A base sensor named by its frame (a URDF's ft_sensor_link; here the paper arm's 'sensor'),
+// which the review found users had to copy by hand from `info`.
+TEST(EstimatorConfig, TheSensorPoseMayBeAFrameOfTheRootLink) {
+  const EstimatorConfig c = load_estimator_config_string(
+      "robot: ../../../models/paper_arm.urdf\nsensor: {type: ft, frame: sensor}\n",
+      kDir / "frame.yaml");
+  const Model& m = c.robot.model;
+  const Frame& f = m.frames[static_cast<std::size_t>(*m.find_frame("sensor"))];
+  EXPECT_EQ(f.body, 0);
+  EXPECT_TRUE(c.options.sensor.X_WS.is_approx(f.placement, 0.0));
+  EXPECT_TRUE(c.options.sensor.X_WS.is_approx(Pose{Matrix3::Identity(), Vector3(0, 0, -0.31)},
+                                              1e-12));  // the URDF's sensor_joint, read here
+  EXPECT_EQ(c.sensor_pose_source, "sensor.frame 'sensor'");
+}
+
 TEST(EstimatorConfig, RobotPathIsRelativeToTheConfigFileAndKnownPointLinksResolveByName) {
   const EstimatorConfig c = load_estimator_config(kDir / "known_point_force.yaml");
   EXPECT_TRUE(std::filesystem::equivalent(
@@ -259,6 +274,13 @@ INSTANTIATE_TEST_SUITE_P(
         BadConfig{"sensor:\n  type: ft\n  pose: {xyz: [0, a, 0]}\n", ":4:", "sensor.pose.xyz[1]",
                   "finite number"},
         BadConfig{"sensor: {type: ft, tare: -3}\n", ":2:", "sensor.tare", "whole number"},
+        BadConfig{"sensor: {type: ft, frame: ft_link}\n", ":2:", "sensor.frame",
+                  "'ft_link' is not a frame of robot 'paper_arm' (frames on the root link "
+                  "'link0': "},
+        BadConfig{"sensor: {type: ft, frame: link3}\n", ":2:", "sensor.frame",
+                  "'link3' is on the moving link 'link3': a base sensor is under the root link"},
+        BadConfig{"sensor: {type: ft, frame: sensor, pose: {xyz: [0, 0, 0]}}\n",
+                  ":2:", "sensor.frame", "give either sensor.pose or sensor.frame, not both"},
         BadConfig{"sensor: {type: none}\nobserver:\n  gain: fast\n", ":4:", "observer.gain",
                   "finite number"},
         BadConfig{"sensor: {type: none}\nobserver:\n  gain: -5\n", ":4:", "observer.gain", "> 0"},

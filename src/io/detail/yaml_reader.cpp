@@ -121,6 +121,13 @@ void YamlReader::keys_of(
                                                                                   : "null"));
     }
     const std::string k = kv.first.Scalar();
+    // `<<: *base` (YAML 1.1's merge key, for sweeps of schemes) is a plain key to yaml-cpp: the
+    // merged keys would be missing, reported as such far from the cause.
+    if (k == "<<") {
+      fail(kv.first, key(context, k),
+           "YAML merge keys (<<: *anchor) are not supported by this YAML reader (yaml-cpp): "
+           "write the keys out, or alias whole values (sensor: *ft_sensor)");
+    }
     check(kv.first, k);
     const auto [first, inserted] = seen.emplace(k, kv.first);
     if (!inserted) {
