@@ -1,9 +1,11 @@
 #include "extwrench/app/scenario_run.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -433,6 +435,44 @@ std::vector<SeedResult> run_jobs_of(const Scenario& s, const std::filesystem::pa
 
 }  // namespace
 
+namespace {
+
+// What an earlier run into the same directory left that this run did not write (a scheme since
+// renamed, other seeds, a single-seed log beside seed directories): its estimates would be read
+// beside this run's log as if they were of it.
+std::vector<std::filesystem::path> earlier_outputs(const Scenario& s,
+                                                   const std::filesystem::path& out_dir) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> found;
+  std::vector<fs::path> seed_dirs;
+  for (const std::uint64_t seed : s.seeds) seed_dirs.push_back(seed_dir(s, seed, out_dir));
+  const auto is_scheme = [&](const std::string& name) {
+    return std::any_of(s.schemes.begin(), s.schemes.end(),
+                       [&](const SchemeSpec& scheme) { return scheme.name == name; });
+  };
+  std::error_code ec;
+  for (const fs::path& dir : seed_dirs) {
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      const fs::path p = entry.path();
+      if (entry.is_directory(ec) && fs::exists(p / "config.yaml", ec) &&
+          !is_scheme(p.filename().string()))
+        found.push_back(p);
+    }
+  }
+  for (const auto& entry : fs::directory_iterator(out_dir, ec)) {
+    const fs::path p = entry.path();
+    if (entry.is_directory(ec) && p.filename().string().rfind("seed_", 0) == 0 &&
+        std::find(seed_dirs.begin(), seed_dirs.end(), p) == seed_dirs.end())
+      found.push_back(p);
+  }
+  if (s.seeds.size() > 1 && fs::exists(out_dir / "log.csv", ec))
+    found.push_back(out_dir / "log.csv");
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+}  // namespace
+
 std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::path& out_dir,
                                      const RunOptions& options, RunSummary* summary) {
   const Model& model = s.robot.model;
@@ -451,6 +491,16 @@ std::vector<SeedResult> run_scenario(const Scenario& s, const std::filesystem::p
   }
   transactions.keep();
   outputs.keep();
+  if (const auto earlier = earlier_outputs(s, out_dir); !earlier.empty()) {
+    std::ostream& console = options.messages != nullptr ? *options.messages : std::cerr;
+    std::string list;
+    for (std::size_t i = 0; i < earlier.size() && i < 6; ++i)
+      list += (i ? ", " : "") + earlier[i].string();
+    if (earlier.size() > 6) list += " and " + std::to_string(earlier.size() - 6) + " more";
+    console << "extwrench: note: " << out_dir.string() << " also holds " << list
+            << ", left by an earlier run (not a seed or scheme of this scenario): they are not "
+               "this run's results; remove them, or give a fresh --out\n";
+  }
   return results;
 }
 

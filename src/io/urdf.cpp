@@ -102,6 +102,7 @@ class UrdfParser {
         builder.add_joint(parse_joint(e));
       }
     }
+    check_mimics(robot, options);
     lock_joints(options, builder);
     RobotDescription robot_description;
     robot_description.model = builder.build();
@@ -162,6 +163,30 @@ class UrdfParser {
     const XMLElement* c = e->FirstChildElement(name);
     if (c == nullptr) fail(e, owner, std::string("missing element <") + name + ">");
     return c;
+  }
+
+  // A <mimic> joint follows its leader, which this model does not enforce: it stays a joint of
+  // its own. Locking the leader alone then left the follower free (the Panda's second finger as
+  // q8, met as a missing log column); the follower's value is known, so say it.
+  void check_mimics(const XMLElement* robot, const LoadOptions& options) const {
+    for (const XMLElement* e = robot->FirstChildElement("joint"); e != nullptr;
+         e = e->NextSiblingElement("joint")) {
+      const XMLElement* mimic = e->FirstChildElement("mimic");
+      const char* follower = e->Attribute("name");
+      if (mimic == nullptr || follower == nullptr) continue;
+      const std::string owner = "joint '" + std::string(follower) + "'";
+      const std::string leader = required(mimic, "joint", owner);
+      const auto locked = options.locked_joints.find(leader);
+      if (locked == options.locked_joints.end() || options.locked_joints.count(follower) != 0)
+        continue;
+      const double value = number(mimic, "multiplier", owner, 1.0) * locked->second +
+                           number(mimic, "offset", owner, 0.0);
+      char shown[32];  // as a user would type it (0.3, not 0.30000000000000004)
+      std::snprintf(shown, sizeof shown, "%.12g", value);
+      fail(mimic, owner,
+           "follows joint '" + leader + "' (<mimic>), which is locked: lock it too, at " +
+               std::string(shown) + " (--lock " + follower + "=" + shown + ")");
+    }
   }
 
   double number(const XMLElement* e, const char* attr, const std::string& owner,

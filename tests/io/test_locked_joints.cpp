@@ -16,6 +16,7 @@
 #include "extwrench/estimation/estimator_options.hpp"
 #include "extwrench/io/estimator_config.hpp"
 #include "extwrench/io/robot_loader.hpp"
+#include "support/error_of.hpp"
 #include "support/io_test_util.hpp"
 
 namespace extwrench {
@@ -122,6 +123,28 @@ TEST(LockedJoints, AChainJointCanBeLockedToo) {
   EXPECT_EQ(m.nq(), 1);
   EXPECT_EQ(m.joints[1].name, "shoulder");
   EXPECT_EQ(m.body_index("hand"), 1);
+}
+
+// A <mimic> follower of a locked joint would stay free (the Panda's second finger became q8, met
+// later as a missing log column): refused, with the value its <mimic> gives.
+TEST(LockedJoints, TheFollowerOfALockedMimicLeaderIsNamedWithItsValue) {
+  const std::string xml =
+      replaced(read(kTree), "<limit lower=\"-1\" upper=\"1\" effort=\"5\" velocity=\"1\"/>",
+               "<limit lower=\"-1\" upper=\"1\" effort=\"5\" velocity=\"1\"/>\n"
+               "    <mimic joint=\"finger_slide\" multiplier=\"10\" offset=\"0.1\"/>");
+  const std::string what = test::error_of([&] {
+    (void)load_urdf_string(xml, "mimic.urdf", locks({{"finger_slide", 0.02}}));
+  });
+  EXPECT_NE(what.find("mimic.urdf:"), std::string::npos) << what;
+  EXPECT_NE(what.find("joint 'finger_hinge': follows joint 'finger_slide' (<mimic>), which is "
+                      "locked: lock it too, at 0.3 (--lock finger_hinge=0.3)"),
+            std::string::npos)
+      << what;
+  EXPECT_EQ(
+      load_urdf_string(xml, "mimic.urdf", locks({{"finger_slide", 0.02}, {"finger_hinge", 0.3}}))
+          .model.nq(),
+      2);
+  EXPECT_EQ(load_urdf_string(xml, "mimic.urdf", locks({})).model.nq(), 4);  // no lock: joints
 }
 
 TEST(LockedJoints, BadLocksAreClearErrors) {

@@ -252,6 +252,29 @@ TEST_F(Cli, SimulateNotesAPushAfterTheEndAndInventsNoWorstValues) {
   EXPECT_NE(worst.find("- m"), std::string::npos) << worst;
 }
 
+// A sweep run again into the same --out with a scheme renamed left the old scheme's estimates
+// beside the new log without a word (a review's): noted, and not removed.
+TEST_F(Cli, SimulateNotesWhatAnEarlierRunLeftInItsDirectory) {
+  const std::string scenario = "robot: " + (kModels / "paper_arm.urdf").string() +
+                               "\nseeds: [1, 2]\nduration: 0.05\ntrajectory: {offset: 0.3}\n"
+                               "schemes:\n  ft_k25: {sensor: {type: ft}, observer: {gain: 25}}\n";
+  write_text(path("k25.yaml"), scenario);
+  std::string renamed = scenario;
+  renamed.replace(renamed.find("ft_k25"), 6, "ft_k50");
+  write_text(path("k50.yaml"), renamed);
+  const std::string out = " --no-figures --out '" + path("sweep").string() + "'";
+  const RunResult first = run("simulate '" + path("k25.yaml").string() + "'" + out);
+  ASSERT_EQ(first.code, 0) << first.err;
+  EXPECT_FALSE(contains(first.err, "earlier run")) << first.err;
+  const RunResult second = run("simulate '" + path("k50.yaml").string() + "'" + out);
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_TRUE(contains(second.err, "also holds " + path("sweep/seed_1/ft_k25").string() + ", " +
+                                       path("sweep/seed_2/ft_k25").string() +
+                                       ", left by an earlier run"))
+      << second.err;
+  EXPECT_TRUE(fs::exists(path("sweep/seed_1/ft_k25/estimates.csv")));  // the user's to remove
+}
+
 // ---- info --------------------------------------------------------------------------------
 
 /// Link names and masses read from the URDF text by the test (independent of our parser).
