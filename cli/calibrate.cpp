@@ -22,6 +22,7 @@ struct CalibrateOptions {
   CalibrateArguments arguments;
   std::vector<std::filesystem::path> package_path;
   std::vector<std::string> lock;
+  std::string root_body, tip_body;  ///< MJCF only
 };
 
 // "smoothing_velocity" -> "--smoothing-velocity"; values as typed; "--sign dahl".
@@ -44,7 +45,9 @@ void run_calibrate(const CalibrateOptions& opt) {
               "calibrate writes CALIB.yaml to a file, not to standard output (its report goes "
               "there); give a file path");
   check_output_file(opt.out, "--out", {opt.config, opt.log});
-  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  load.root_body = opt.root_body;
+  load.tip_body = opt.tip_body;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   const auto start = std::chrono::steady_clock::now();
   const CalibrateLogResult run =
@@ -119,6 +122,7 @@ void register_calibrate(CLI::App& app) {
                 "arm); without it they are an error, as for estimate");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
+  add_chain_options(*sub, opt->root_body, opt->tip_body);
   sub->footer(help_footer(
       {{"extwrench calibrate --config panda.yaml --log free.csv --out calib.yaml --holdout 0.4",
         "fit on the first 60 % of a contact-free log, report false alarms and the smallest "

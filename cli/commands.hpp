@@ -50,6 +50,10 @@ void add_package_path_option(CLI::App& sub, std::vector<std::filesystem::path>& 
 /// branches, a gripper's fingers), LoadOptions::locked_joints.
 void add_lock_option(CLI::App& sub, std::vector<std::string>& locks);
 
+/// Adds `--root-body BODY` and `--tip-body BODY`: the chain of an MJCF scene
+/// (LoadOptions::root_body, tip_body; root_body, tip_body in a configuration or scenario).
+void add_chain_options(CLI::App& sub, std::string& root_body, std::string& tip_body);
+
 /// LoadOptions from --package-path and --lock; throws UsageError for a --lock that is not
 /// NAME=VALUE with a finite number, or a joint locked twice.
 [[nodiscard]] LoadOptions robot_load_options(const std::vector<std::filesystem::path>& package_path,

@@ -60,6 +60,15 @@ void add_lock_option(CLI::App& sub, std::vector<std::string>& locks) {
       ->type_name("NAME=VALUE");
 }
 
+void add_chain_options(CLI::App& sub, std::string& root_body, std::string& tip_body) {
+  sub.add_option("--root-body", root_body,
+                 "MJCF only: the body that becomes link 0 (for a scene with several bodies)")
+      ->type_name("BODY");
+  sub.add_option("--tip-body", tip_body,
+                 "MJCF only: keep only the chain from the root body to BODY")
+      ->type_name("BODY");
+}
+
 LoadOptions robot_load_options(const std::vector<std::filesystem::path>& package_path,
                                const std::vector<std::string>& locks) {
   LoadOptions options;

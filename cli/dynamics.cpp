@@ -23,6 +23,7 @@ struct DynamicsOptions {
   std::string out;
   std::vector<std::filesystem::path> package_path;
   std::vector<std::string> lock;
+  std::string root_body, tip_body;  ///< MJCF only
 };
 
 /// Columns of the input for an n-joint robot: t, q1..qn, dq1..dqn, ddq1..ddqn.
@@ -50,6 +51,8 @@ void run_dynamics(const DynamicsOptions& opt) {
 
   // Inverse dynamics needs no geometry: a mesh that cannot be found (package://) is no error here.
   LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  load.root_body = opt.root_body;
+  load.tip_body = opt.tip_body;
   load.load_meshes = false;
   const RobotDescription robot = load_robot_file(opt.robot, load);
   const Model& model = robot.model;
@@ -150,6 +153,7 @@ void register_dynamics(CLI::App& app) {
           ->type_name("\"X Y Z R P Y\"");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
+  add_chain_options(*sub, opt->root_body, opt->tip_body);
   sub->footer(
       "\nThe reading is what the robot discharges onto the sensor: force and moment about the "
       "sensor\n"

@@ -39,6 +39,7 @@ struct EstimateOptions {
   bool ignore_extra_joints = false;
   std::vector<std::filesystem::path> package_path;
   std::vector<std::string> lock;
+  std::string root_body, tip_body;  ///< MJCF only
 };
 
 std::pair<double, double> parse_interval(const std::string& text) {
@@ -188,7 +189,9 @@ void run_estimate(const EstimateOptions& opt) {
   if (!(opt.plot_points >= 10)) throw UsageError("--plot-points must be at least 10");
   const LogInputs inputs = expand_logs(opt.logs);
   const std::vector<std::filesystem::path> dirs = output_dirs(inputs, opt.out);
-  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  load.root_body = opt.root_body;
+  load.tip_body = opt.tip_body;
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   for (const auto& log : inputs.logs) check_input_file(log, "log");
   common.note_frequent_alarms = config.calibration_path.empty();
@@ -275,6 +278,7 @@ void register_estimate(CLI::App& app) {
                 "without it they are an error");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
+  add_chain_options(*sub, opt->root_body, opt->tip_body);
   sub->footer(help_footer(
       {{"extwrench estimate --config results/paper/seed_1/ft/config.yaml --log "
         "results/paper/seed_1/log.csv --out results/replay",

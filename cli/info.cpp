@@ -147,12 +147,7 @@ void register_info(CLI::App& app) {
   sub->add_option("ROBOT", opt->robot, kRobotFileHelp)->required()->type_name("FILE");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
-  sub->add_option("--root-body", opt->root_body,
-                  "MJCF only: the body that becomes link 0 (for a scene with several bodies)")
-      ->type_name("BODY");
-  sub->add_option("--tip-body", opt->tip_body,
-                  "MJCF only: keep only the chain from the root body to BODY")
-      ->type_name("BODY");
+  add_chain_options(*sub, opt->root_body, opt->tip_body);
   sub->footer(help_footer(
       {{"extwrench info models/paper_arm.urdf",
         "the paper's arm: bodies, joints q1..q7 (the CSV columns' order), frames, sensor pose, "

@@ -25,6 +25,7 @@ struct SimulateOptions {
   std::string figure_format = "png";
   std::vector<std::filesystem::path> package_path;
   std::vector<std::string> lock;
+  std::string root_body, tip_body;  ///< MJCF only
 };
 
 const NamedMetrics* window_named(const ReplayResult& r, const std::string& name) {
@@ -90,7 +91,9 @@ void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
 void run_simulate(const SimulateOptions& opt) {
   refuse_dash(opt.out, "--out",
               "simulate writes a directory of files, not standard output; give a directory path");
-  const LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
+  load.root_body = opt.root_body;
+  load.tip_body = opt.tip_body;
   const Scenario scenario = load_scenario(opt.scenario, load);
   const Pose& X_WS = scenario.simulation.sensor.X_WS;
   const bool default_pose =
@@ -113,9 +116,9 @@ void run_simulate(const SimulateOptions& opt) {
   }
   // Likewise metrics windows beside the run: a table of dashes must not read as a failed run.
   const double duration = scenario.simulation.duration;
-  if (scenario.metrics_from >= duration) {
+  if (scenario.metrics_from > duration) {
     std::fprintf(stderr,
-                 "extwrench simulate: note: metrics.from is %g s, at or after the run's end "
+                 "extwrench simulate: note: metrics.from is %g s, after the run's end "
                  "(duration %g s): no sample is measured, every metric is empty\n",
                  scenario.metrics_from, duration);
   }
@@ -189,6 +192,7 @@ void register_simulate(CLI::App& app) {
   add_figure_format_option(*sub, opt->figure_format);
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
+  add_chain_options(*sub, opt->root_body, opt->tip_body);
   sub->footer(help_footer(
       {{"extwrench simulate scenarios/paper.yaml --out results/paper",
         "the paper's experiment (Section IV): the closed loop, then every estimator scheme on its "

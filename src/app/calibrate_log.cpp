@@ -128,11 +128,12 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
     detail::check_sensor_columns(reader, config.options.sensor.type);
     for (Sample s; reader.next(s);) samples.push_back(s);
   }
-  // Positions in degrees fit friction and thresholds to nonsense (10 000 N m) without a word.
+  // Positions in degrees fit friction and thresholds to nonsense (10 000 N m) without a word:
+  // refused; a few rows outside (a glitch) are warned about.
   detail::JointRangeCheck joint_range(model);
   for (const Sample& s : samples) joint_range.add(s);
-  if (const std::string range = joint_range.note(); !range.empty())
-    throw Error(log.string() + ": " + range);
+  const std::string range = joint_range.note();
+  if (joint_range.mostly_outside()) throw Error(log.string() + ": " + range);
   CalibrateLogResult result;
   result.rows = samples.size();
   result.fit_rows = static_cast<std::size_t>(static_cast<double>(samples.size()) * (1.0 - holdout));
@@ -155,6 +156,8 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
   }
   if (truth_note)
     result.calibration.warnings.insert(result.calibration.warnings.begin(), *truth_note);
+  if (!range.empty())
+    result.calibration.warnings.insert(result.calibration.warnings.begin(), range);
   result.calibration.source = log.string();
   if (holdout > 0)
     result.holdout =

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 
 #include "extwrench/core/error.hpp"
@@ -61,10 +62,13 @@ JointRangeCheck::JointRangeCheck(const Model& model) : model_(&model) {
   const int n = model.nq();
   for (int i = 1; i <= n; ++i) {
     const Joint& j = model.joints[static_cast<std::size_t>(i)];
-    const double margin =
-        std::isfinite(j.upper - j.lower) ? std::max(0.1 * (j.upper - j.lower), 0.1) : 0.0;
-    lower_.push_back(j.lower - margin);
-    upper_.push_back(j.upper + margin);
+    const double range = j.upper - j.lower;
+    // No limits (continuous), or none worth the name (lower = upper = 0: a URDF's default, an
+    // exporter's placeholder): nothing to check against.
+    const bool checked = std::isfinite(range) && range > 0.0;
+    const double margin = checked ? std::max(0.1 * range, 0.1) : 0.0;
+    lower_.push_back(checked ? j.lower - margin : -std::numeric_limits<double>::infinity());
+    upper_.push_back(checked ? j.upper + margin : std::numeric_limits<double>::infinity());
   }
   outside_.assign(lower_.size(), 0);
   furthest_.assign(lower_.size(), 0.0);
@@ -84,6 +88,10 @@ void JointRangeCheck::add(const Sample& sample) noexcept {
   }
 }
 
+bool JointRangeCheck::mostly_outside() const noexcept {
+  return std::any_of(outside_.begin(), outside_.end(), [&](long o) { return 2 * o > rows_; });
+}
+
 std::string JointRangeCheck::note() const {
   std::size_t worst = lower_.size();
   for (std::size_t i = 0; i < lower_.size(); ++i) {
@@ -96,14 +104,17 @@ std::string JointRangeCheck::note() const {
   char shown[32];
   std::snprintf(shown, sizeof shown, "%.4g", furthest_[worst]);
   return "q" + std::to_string(worst + 1) + " (joint '" + j.name + "') lies outside its limits [" +
-         format_number(j.lower) + ", " + format_number(j.upper) + "] on " +
-         std::to_string(outside_[worst]) + " of " + std::to_string(rows_) + " rows (up to " +
-         std::string(shown) + ")" +
+         format_number(j.lower) + ", " + format_number(j.upper) +
+         "] (by more than a tenth of the range) on " + std::to_string(outside_[worst]) + " of " +
+         std::to_string(rows_) + " rows (up to " + std::string(shown) + ")" +
          (joints > 1 ? ", and " + std::to_string(joints - 1) + " more joint" +
                            (joints > 2 ? "s" : "") + " too"
                      : std::string()) +
-         ": are the positions in degrees, or of another robot? The model takes radians (and "
-         "metres), in its joints' order";
+         (mostly_outside()
+              ? ": are the positions in degrees, or of another robot? The model takes radians "
+                "(and metres), in its joints' order"
+              : ": an encoder's wrap or a glitch in those rows, or limits in the model that "
+                "the robot exceeds? The estimates there use the positions as they are");
 }
 
 }  // namespace extwrench::detail

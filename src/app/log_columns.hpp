@@ -20,13 +20,16 @@ void check_joint_columns(const LogReader& reader, int n, bool ignore);
 void check_sensor_columns(const LogReader& reader, SensorType sensor);
 
 /// Joint positions far outside the model's limits (by more than a tenth of the range, at least
-/// 0.1 rad or m): most often a log in degrees. Fed row by row; note() describes the joint that
-/// strays furthest, "" when none does.
+/// 0.1 rad or m; joints without limits, or with lower = upper, are not checked): on most rows,
+/// most often a log in degrees; on a few, an encoder's wrap or a glitch. Fed row by row; note()
+/// describes the joint outside on the most rows, "" when none is.
 class JointRangeCheck {
  public:
   explicit JointRangeCheck(const Model& model);
   void add(const Sample& sample) noexcept;
   [[nodiscard]] std::string note() const;
+  /// Some joint is outside on more than half of the rows (degrees, another robot's log).
+  [[nodiscard]] bool mostly_outside() const noexcept;
 
  private:
   const Model* model_;

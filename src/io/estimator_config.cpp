@@ -350,6 +350,13 @@ void read_robot(const YamlReader& rd, const YAML::Node& root, const fs::path& so
   if (root["locked_joints"])
     rd.locked_joints(root["locked_joints"], "locked_joints", robot_options);
   cfg.locked_joints = robot_options.locked_joints;
+  // The command line's --root-body, --tip-body win over the file's, as --lock does.
+  if (root["root_body"] && robot_options.root_body.empty())
+    robot_options.root_body = rd.string(root["root_body"], "root_body");
+  if (root["tip_body"] && robot_options.tip_body.empty())
+    robot_options.tip_body = rd.string(root["tip_body"], "tip_body");
+  cfg.root_body = robot_options.root_body;
+  cfg.tip_body = robot_options.tip_body;
   try {
     cfg.robot = load_robot(cfg.robot_path, robot_options);
   } catch (const Error& e) {
@@ -363,9 +370,9 @@ EstimatorConfig interpret(const YAML::Node& root, const fs::path& source,
   const YamlReader rd(source.string());
   if (!root.IsDefined() || root.IsNull()) rd.fail(root, "(top level)", "empty configuration");
   rd.only_keys(root, "",
-               {"robot", "locked_joints", "gravity", "sensor", "contact", "observer", "detection",
-                "acceleration", "friction", "armature", "payload", "solver", "isolation",
-                "uncertainty", "calibration", "drift"});
+               {"robot", "locked_joints", "root_body", "tip_body", "gravity", "sensor", "contact",
+                "observer", "detection", "acceleration", "friction", "armature", "payload",
+                "solver", "isolation", "uncertainty", "calibration", "drift"});
   EstimatorConfig cfg;
   cfg.source = source;
   read_robot(rd, root, source, robot_options, cfg);
@@ -467,6 +474,8 @@ std::string to_yaml(const EstimatorConfig& config, const std::filesystem::path& 
     }
     y << "}\n";
   }
+  if (!config.root_body.empty()) y << "root_body: " << yaml_scalar(config.root_body) << '\n';
+  if (!config.tip_body.empty()) y << "tip_body: " << yaml_scalar(config.tip_body) << '\n';
   y << "gravity: " << list3(model.gravity) << '\n';
   y << "sensor:\n  type: " << to_string(o.sensor.type) << '\n';
   const Vector3 rpy = rpy_from_rotation(o.sensor.X_WS.rotation);

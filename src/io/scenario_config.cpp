@@ -224,6 +224,11 @@ void parse_robot(const YamlReader& y, const YAML::Node& root, const LoadOptions&
     y.fail(root["robot"], "robot", "no such file '" + s.robot_path.string() + "'");
   LoadOptions options = robot_options;
   if (root["locked_joints"]) y.locked_joints(root["locked_joints"], "locked_joints", options);
+  // An MJCF scene's chain; --root-body, --tip-body win.
+  if (root["root_body"] && options.root_body.empty())
+    options.root_body = y.string(root["root_body"], "root_body");
+  if (root["tip_body"] && options.tip_body.empty())
+    options.tip_body = y.string(root["tip_body"], "tip_body");
   s.robot = load_robot(s.robot_path, options);
   s.robot_options = options;
 }
@@ -515,9 +520,10 @@ Scenario read_scenario(const std::filesystem::path& path, const LoadOptions& rob
   const YAML::Node root = io_detail::load_yaml_file(path, "scenario");
   if (!root.IsDefined() || root.IsNull()) throw Error(y.file() + ": the scenario is empty");
   y.only_keys(root, "",
-              {"robot", "locked_joints", "seed", "seeds", "duration", "sample_time", "substeps",
-               "model_error", "trajectory", "controller", "forces", "sensors", "metrics", "figures",
-               "schemes", "engine", "obstacles", "mujoco_option"});
+              {"robot",      "locked_joints", "root_body",   "tip_body",  "seed",
+               "seeds",      "duration",      "sample_time", "substeps",  "model_error",
+               "trajectory", "controller",    "forces",      "sensors",   "metrics",
+               "figures",    "schemes",       "engine",      "obstacles", "mujoco_option"});
   Scenario s;
   s.source = path;
   parse_robot(y, root, robot_options, s);

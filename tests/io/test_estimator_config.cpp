@@ -107,19 +107,22 @@ TEST(EstimatorConfig, EverythingButRobotAndSensorTypeHasADefault) {
   EXPECT_TRUE(c.robot.model.gravity.isApprox(Vector3(0, 0, -9.81)));
 }
 
-// A base sensor named by its frame (a URDF's ft_sensor_link; here the paper arm's 'sensor'),
-// which the review found users had to copy by hand from `info`.
+// A base sensor named by its frame (a URDF's ft_sensor_link), which the review found users had
+// to copy by hand from `info`: the paper arm's 'sensor' (0.31 m below O_0, its URDF's
+// sensor_joint), and its root link's own frame 'link0', which is not the default.
 TEST(EstimatorConfig, TheSensorPoseMayBeAFrameOfTheRootLink) {
-  const EstimatorConfig c = load_estimator_config_string(
-      "robot: ../../../models/paper_arm.urdf\nsensor: {type: ft, frame: sensor}\n",
-      kDir / "frame.yaml");
-  const Model& m = c.robot.model;
-  const Frame& f = m.frames[static_cast<std::size_t>(*m.find_frame("sensor"))];
-  EXPECT_EQ(f.body, 0);
-  EXPECT_TRUE(c.options.sensor.X_WS.is_approx(f.placement, 0.0));
-  EXPECT_TRUE(c.options.sensor.X_WS.is_approx(Pose{Matrix3::Identity(), Vector3(0, 0, -0.31)},
-                                              1e-12));  // the URDF's sensor_joint, read here
-  EXPECT_EQ(c.sensor_pose_source, "sensor.frame 'sensor'");
+  const auto load = [](const std::string& frame) {
+    return load_estimator_config_string(
+        "robot: ../../../models/paper_arm.urdf\nsensor: {type: ft, frame: " + frame + "}\n",
+        kDir / "frame.yaml");
+  };
+  const EstimatorConfig sensor = load("sensor");
+  EXPECT_TRUE(
+      sensor.options.sensor.X_WS.is_approx(Pose{Matrix3::Identity(), Vector3(0, 0, -0.31)}, 1e-12));
+  EXPECT_EQ(sensor.sensor_pose_source, "sensor.frame 'sensor'");
+  const EstimatorConfig root = load("link0");
+  EXPECT_TRUE(root.options.sensor.X_WS.is_approx(Pose::identity(), 0.0));
+  EXPECT_EQ(root.sensor_pose_source, "sensor.frame 'link0'");
 }
 
 TEST(EstimatorConfig, RobotPathIsRelativeToTheConfigFileAndKnownPointLinksResolveByName) {

@@ -228,7 +228,7 @@ TEST_F(Cli, SimulateNotesAPushAfterTheEndAndInventsNoWorstValues) {
                  "\nseeds: [1, 2]\nduration: 0.3\ntrajectory: {offset: 0.3, amplitude: 0.2, "
                  "frequency: 0.5, phase: 0}\nforces:\n  - {frame: link6, axes: frame, force: [20, "
                  "0, 0], point: [0, 0, 0.1], start: 5}\nschemes:\n  ft: {sensor: {type: ft}}\n"
-                 "metrics: {from: 0.3, exclude: [[10, 20]]}\n");
+                 "metrics: {from: 0.35, exclude: [[10, 20]]}\n");
   const RunResult r = run("simulate --no-figures '" + path("late.yaml").string() + "' --out '" +
                           path("late").string() + "'");
   ASSERT_EQ(r.code, 0) << r.err << r.out;
@@ -237,7 +237,7 @@ TEST_F(Cli, SimulateNotesAPushAfterTheEndAndInventsNoWorstValues) {
                        "0.3 s): it never acts"));
   // So are metrics windows beside the run (a table of dashes read as a failed run).
   EXPECT_TRUE(contains(r.err,
-                       "note: metrics.from is 0.3 s, at or after the run's end (duration 0.3 s): "
+                       "note: metrics.from is 0.35 s, after the run's end (duration 0.3 s): "
                        "no sample is measured, every metric is empty"))
       << r.err;
   EXPECT_TRUE(contains(r.err,

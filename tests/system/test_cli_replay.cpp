@@ -457,6 +457,21 @@ TEST_F(RealLog, PositionsInDegreesAndAGapInTimeAreSaid) {
   EXPECT_EQ(calibrate.code, 1);
   EXPECT_TRUE(contains(calibrate.err, "are the positions in degrees")) << calibrate.err;
   EXPECT_FALSE(fs::exists(dir_ / "degrees_calib.yaml"));
+  // One row wrapped by 2π (an encoder's glitch): said as such, not as degrees.
+  std::string wrapped = log;
+  std::size_t at = 0;
+  for (int line = 0; line < 500; ++line) at = wrapped.find('\n', at) + 1;
+  const std::size_t q1 = wrapped.find(',', at) + 1, q1_end = wrapped.find(',', q1);
+  char cell[32];
+  std::snprintf(cell, sizeof cell, "%.17g",
+                std::stod(wrapped.substr(q1, q1_end - q1)) + 2 * 3.141592653589793);
+  wrapped.replace(q1, q1_end - q1, cell);
+  write_text(dir_ / "wrapped.csv", wrapped);
+  const CliRun glitch = estimate(none, "wrapped", "--no-figures", "wrapped.csv");
+  ASSERT_EQ(glitch.code, 0) << glitch.err;
+  EXPECT_TRUE(contains(glitch.err, "on 1 of ")) << glitch.err;
+  EXPECT_TRUE(contains(glitch.err, "an encoder's wrap or a glitch")) << glitch.err;
+  EXPECT_FALSE(contains(glitch.err, "degrees")) << glitch.err;
   // In radians, as simulated: no word of it.
   const CliRun radians = estimate(none, "radians", "--no-figures");
   EXPECT_FALSE(contains(radians.err, "outside its limits")) << radians.err;

@@ -42,6 +42,9 @@ struct EstimatorConfig {
   RobotDescription robot;            ///< loaded robot (gravity from the config applied)
   /// Joints locked when loading it (the file's locked_joints and LoadOptions'), for to_yaml.
   std::map<std::string, double> locked_joints;
+  /// The chain chosen in an MJCF scene (the file's root_body, tip_body, or LoadOptions'), for
+  /// to_yaml; empty when not chosen.
+  std::string root_body, tip_body;
   EstimatorOptions options;  ///< link names resolved to body indices, sizes checked
   /// Where options.sensor.X_WS came from: "sensor.pose" when the file gives it, else the rule
   /// of default_sensor_pose() in words (printed at the start of a replay).
