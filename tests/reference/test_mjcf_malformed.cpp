@@ -9,6 +9,7 @@
 
 #include "extwrench/bridges/mjcf.hpp"
 #include "extwrench/core/error.hpp"
+#include "extwrench/io/estimator_config.hpp"
 #include "support/scratch_dir.hpp"
 
 namespace extwrench {
@@ -191,6 +192,36 @@ TEST_F(MjcfMalformed, UnknownLockedJointIsTheBuildersError) {
 TEST_F(MjcfMalformed, DirectoryAndMissingFileAreInputErrors) {
   EXPECT_TRUE(has_all(error_of(dir_.string()), {dir_.string()}));
   EXPECT_TRUE(has_all(error_of((dir_ / "absent.xml").string()), {"absent.xml"}));
+}
+
+// A scene's chain chosen in an estimator configuration (root_body, tip_body), which the loader's
+// message named before the keys existed; --root-body (LoadOptions) wins; written back by
+// to_yaml.
+TEST_F(MjcfMalformed, AConfigurationChoosesTheChainOfAScene) {
+  std::string two = arm();
+  two.insert(two.find("</worldbody>"),
+             "<body name=\"other\"><geom size=\"0.1\"/><body name=\"o1\"><joint name=\"oj\"/>"
+             "<geom size=\"0.1\"/></body></body>\n");
+  write("two.xml", two);
+  const std::string config =
+      write("two.yaml", "robot: two.xml\nroot_body: other\nsensor: {type: none}\n");
+  mujoco::register_mjcf_loader();
+  const EstimatorConfig c = load_estimator_config(config);
+  EXPECT_EQ(c.robot.model.bodies[0].name, "other");
+  EXPECT_EQ(c.robot.model.joints[1].name, "oj");
+  EXPECT_NE(to_yaml(c, dir_).find("root_body: other\n"), std::string::npos) << to_yaml(c, dir_);
+  LoadOptions command_line;
+  command_line.root_body = "base";
+  EXPECT_EQ(load_estimator_config(config, command_line).robot.model.joints[1].name, "j1");
+  // Without the key: the scene's two robots, and the message names the key.
+  write("none.yaml", "robot: two.xml\nsensor: {type: none}\n");
+  try {
+    (void)load_estimator_config(dir_ / "none.yaml");
+    ADD_FAILURE() << "a scene with two robots loaded without a root";
+  } catch (const Error& e) {
+    EXPECT_TRUE(has_all(e.what(), {"none.yaml", "root_body"}));
+  }
+  set_mjcf_loader(nullptr);
 }
 
 TEST_F(MjcfMalformed, LoadRobotReadsMjcfOnceRegistered) {
