@@ -161,6 +161,23 @@ TEST_F(MjcfMalformed, WorldAsRootKeepsEveryTopLevelBodyButNotTheFloor) {
   EXPECT_TRUE(robot.geometry.shapes.empty());
 }
 
+// A hand welded to the tip moves with it: kept, with its mass (the review's Panda lost its
+// 0.73 kg hand with --tip-body link7); a finger on a slide joint beyond it is dropped.
+TEST_F(MjcfMalformed, TheTipKeepsWhatIsWeldedToIt) {
+  const std::string hand =
+      "<body name=\"hand\" pos=\"0 0 0.2\"><inertial pos=\"0 0 0.05\" mass=\"0.7\" "
+      "diaginertia=\"0.002 0.002 0.002\"/>\n<body name=\"finger\"><joint name=\"slide\" "
+      "type=\"slide\" axis=\"0 1 0\"/><inertial pos=\"0 0 0.1\" mass=\"0.1\" "
+      "diaginertia=\"1e-4 1e-4 1e-4\"/></body>\n</body>";
+  const std::string path = write("hand.xml", arm("<joint name=\"j1\" axis=\"0 0 1\"/>", hand));
+  const RobotDescription robot = mujoco::load_mjcf(path, chain("", "link1"));
+  EXPECT_EQ(robot.model.nq(), 1);
+  double total = 0.0;
+  for (const Body& b : robot.model.bodies) total += b.inertia.mass;
+  EXPECT_DOUBLE_EQ(total, 1.0 + 1.0 + 0.7);          // base, link1, the hand; not the finger
+  EXPECT_EQ(mujoco::load_mjcf(path).model.nq(), 2);  // without a tip: the whole tree
+}
+
 TEST_F(MjcfMalformed, UnknownRootOrTipNamesTheOption) {
   const std::string path = write("arm.xml", arm());
   EXPECT_TRUE(has_all(error_of(path, chain("nope")), {path, "root_body 'nope'", "'base'"}));

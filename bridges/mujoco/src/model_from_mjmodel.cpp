@@ -65,7 +65,8 @@ int choose_root(const mjModel* m, const std::string& file, const LoadOptions& op
               "): choose one with root_body (--root-body BODY)");
 }
 
-// Bodies kept: the root's subtree, or only the path root -> tip.
+// Bodies kept: the root's subtree, or only the path root -> tip and what is welded to the tip
+// (a hand on the flange: its mass moves with the tip; bodies beyond a joint are dropped).
 std::vector<bool> kept_bodies(const mjModel* m, const std::string& file, int root,
                               const LoadOptions& options) {
   std::vector<bool> keep(static_cast<std::size_t>(m->nbody), false);
@@ -83,6 +84,12 @@ std::vector<bool> kept_bodies(const mjModel* m, const std::string& file, int roo
   for (int b = tip;; b = m->body_parentid[b]) {
     keep[static_cast<std::size_t>(b)] = true;
     if (b == root) break;
+  }
+  for (int b = 0; b < m->nbody; ++b) {
+    if (b == tip || !mj::is_in_subtree(m, tip, b)) continue;
+    bool welded = true;
+    for (int a = b; a != tip; a = m->body_parentid[a]) welded = welded && m->body_jntnum[a] == 0;
+    keep[static_cast<std::size_t>(b)] = welded;
   }
   return keep;
 }
