@@ -3,14 +3,17 @@
 // attribute and the offending text. The subset and the <capsule> extension: docs/model.md.
 #include <tinyxml2.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string_view>
+#include <vector>
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/input_file.hpp"
+#include "extwrench/io/nearest_name.hpp"
 #include "extwrench/io/number_text.hpp"
 #include "extwrench/io/robot_loader.hpp"
 #include "extwrench/model/model_builder.hpp"
@@ -224,12 +227,34 @@ class UrdfParser {
                               vector3(o, "rpy", owner, Vector3::Zero()));
   }
 
+  // A misspelt element (<orgin>, <inertal>) would be skipped and the robot built without it: a
+  // joint at the parent's origin, a massless link. URDF's own elements are few and fixed; a
+  // namespaced one (gazebo:..., a tool's) is an extension and passes.
+  void only_elements(const XMLElement* e, const std::string& owner,
+                     const std::vector<std::string>& known) const {
+    for (const XMLElement* c = e->FirstChildElement(); c != nullptr; c = c->NextSiblingElement()) {
+      const std::string name = c->Name();
+      if (name.find(':') != std::string::npos ||
+          std::find(known.begin(), known.end(), name) != known.end())
+        continue;
+      std::string list;
+      for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+      const std::string nearest = nearest_name(name, known);
+      fail(c, owner,
+           "unknown element <" + shown(name) + "> in <" + e->Name() + "> (a URDF <" + e->Name() +
+               "> holds " + list + ")" +
+               (nearest.empty() ? std::string() : ": did you mean <" + nearest + ">?"));
+    }
+  }
+
   LinkSpec parse_link(const XMLElement* e) {
     LinkSpec link;
     link.source = where(e);
     link.name = required(e, "name", "");
     const std::string owner = "link '" + link.name + "'";
+    only_elements(e, owner, {"inertial", "visual", "collision", "self_collision_checking"});
     if (const XMLElement* inertial = e->FirstChildElement("inertial")) {
+      only_elements(inertial, owner, {"origin", "mass", "inertia"});
       // URDF gives the inertia about the CoM in the <inertial><origin> frame: move it to the link
       // frame.
       const Pose X_link_inertial = origin(inertial, owner);
@@ -318,6 +343,9 @@ class UrdfParser {
     j.source = where(e);
     j.name = required(e, "name", "");
     const std::string owner = "joint '" + j.name + "'";
+    only_elements(e, owner,
+                  {"origin", "parent", "child", "axis", "calibration", "dynamics", "limit", "mimic",
+                   "safety_controller"});
     const std::string type = required(e, "type", owner);
     if (type == "revolute") {
       j.type = JointSpecType::kRevolute;

@@ -85,6 +85,14 @@ const std::map<std::string, Expected>& cases() {
        {14, {"<mesh> of link 'arm'", "attribute 'filename'", "does_not_exist.stl", "not found"}}},
       {"link_missing_name.urdf", {8, {"<link>", "attribute 'name': missing"}}},
       {"not_well_formed.urdf", {2, {"not well-formed XML"}}},
+      // Misspelt elements were skipped: the joint at its parent's origin, the link massless.
+      {"joint_origin_misspelt.urdf",
+       {19,
+        {"<orgin> of joint 'j1'", "unknown element <orgin> in <joint>", "did you mean <origin>?"}}},
+      {"link_inertial_misspelt.urdf",
+       {9,
+        {"<inertal> of link 'arm'", "unknown element <inertal> in <link>",
+         "did you mean <inertial>?"}}},
       // A .urdf.xacro loaded as it is lost its gripper without a word (a review's).
       {"xacro_macro_unexpanded.urdf",
        {3, {"<xacro:include>", "a xacro macro", "xacro robot.urdf.xacro > robot.urdf"}}},
