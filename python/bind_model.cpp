@@ -112,8 +112,11 @@ py::dict shape_dict(const CollisionShape& s) {
 std::shared_ptr<Robot> load(const std::filesystem::path& path,
                             const std::vector<std::filesystem::path>& package_path,
                             bool use_ros_package_path, bool load_meshes, const py::object& gravity,
-                            const std::map<std::string, double>& locked_joints) {
+                            const std::map<std::string, double>& locked_joints,
+                            const std::string& root_body, const std::string& tip_body) {
   LoadOptions o;
+  o.root_body = root_body;
+  o.tip_body = tip_body;
   o.package_path = package_path;
   o.locked_joints = locked_joints;
   o.use_ros_package_path = use_ros_package_path;
@@ -225,12 +228,15 @@ World frame W = the robot's root frame.)");
         py::arg("package_path") = std::vector<std::filesystem::path>{},
         py::arg("use_ros_package_path") = true, py::arg("load_meshes") = true,
         py::arg("gravity") = py::none(), py::arg("locked_joints") = std::map<std::string, double>{},
-        R"(Loads a URDF (.urdf, .xml) or a DH table (.yaml, .yml), chosen by extension.
+        py::arg("root_body") = std::string(), py::arg("tip_body") = std::string(),
+        R"(Loads a URDF (.urdf, .xml), a DH table (.yaml, .yml), or an MJCF (.xml, .mjcf with root
+<mujoco>) when the module was built with MuJoCo, as the CLI is.
 
 package_path: directories searched for package://NAME/... (NAME is a subdirectory of each);
 ROS_PACKAGE_PATH is appended when use_ros_package_path. gravity: (3,) in W, overrides the file's.
 locked_joints: {joint name: value [rad | m]}: those joints become fixed at those values and their
 bodies are merged (the reduced serial model of a tree, e.g. a gripper's fingers; docs/model.md).
+root_body, tip_body: MJCF only, the chain of a scene (docs/mujoco.md), as --root-body, --tip-body.
 Raises extwrench.Error with the loader's message (file:line: field: what).)");
 }
 

@@ -51,7 +51,8 @@ class Robot:
 def load_robot(path: PathLike, *, package_path: Sequence[PathLike] = ...,
                use_ros_package_path: bool = ..., load_meshes: bool = ...,
                gravity: Optional[ArrayLike] = ...,
-               locked_joints: Mapping[str, float] = ...) -> Robot: ...
+               locked_joints: Mapping[str, float] = ..., root_body: str = ...,
+               tip_body: str = ...) -> Robot: ...
 
 class ExternalWrench:
     def __init__(self, body: int, force_W: ArrayLike, point_W: ArrayLike = ...,

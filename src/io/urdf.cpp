@@ -63,10 +63,12 @@ class UrdfParser {
     const XMLElement* robot = doc.RootElement();
     if (robot == nullptr) throw Error(file_ + kEmpty);  // only a declaration or comments
     if (robot != nullptr && std::strcmp(robot->Name(), "mujoco") == 0) {
-      throw Error(file_ + ":" + std::to_string(robot->GetLineNum()) +
-                  ": the root element is <mujoco>: an MJCF file. MJCF needs extwrench built with "
-                  "MuJoCo (libmujoco-dev, -DEXTWRENCH_BUILD_MUJOCO=ON) and read through "
-                  "load_robot in a program linked with extwrench::mujoco (the extwrench CLI is)");
+      throw Error(
+          file_ + ":" + std::to_string(robot->GetLineNum()) +
+          ": the root element is <mujoco>: an MJCF file. MJCF needs extwrench built with "
+          "MuJoCo (libmujoco-dev, -DEXTWRENCH_BUILD_MUJOCO=ON) and read through "
+          "load_robot in a program linked with extwrench::mujoco (the extwrench CLI and Python "
+          "module are, when built with it)");
     }
     if (robot == nullptr || std::strcmp(robot->Name(), "robot") != 0) {
       // MuJoCo ignores the root's name in an <include>d file (the Menagerie-style <panda> of a

@@ -133,3 +133,20 @@ def test_locked_joints_equal_the_urdf_with_those_joints_fixed(tmp_path):
                                    extwrench.rnea(reference, q, dq, ddq), rtol=0, atol=1e-12)
     with pytest.raises(extwrench.Error, match="nope"):
         extwrench.load_robot(PAPER_URDF, locked_joints={"nope": 0.0})
+
+
+def test_mjcf_loads_as_in_the_cli():
+    """The paper arm's MJCF twin through MuJoCo's compiler, when the module was built with it
+    (as the CLI is): the same joints and masses as its URDF, read by our parser."""
+    mjcf = SOURCE_DIR / "models" / "paper_arm.xml"
+    try:
+        twin = extwrench.load_robot(mjcf)
+    except extwrench.Error as e:
+        if "MJCF needs extwrench built with MuJoCo" in str(e):
+            pytest.skip("module built without MuJoCo")
+        raise
+    urdf = extwrench.load_robot(PAPER_URDF)
+    assert twin.nq == urdf.nq == 7
+    assert np.isclose(twin.masses.sum(), urdf.masses.sum(), rtol=1e-9, atol=1e-12)
+    assert np.allclose(twin.lower, urdf.lower) and np.allclose(twin.upper, urdf.upper)
+    assert extwrench.load_robot(mjcf, tip_body="link3").nq == 3  # a chain of it, as --tip-body
