@@ -220,7 +220,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
     messages_of(o) << "extwrench: note: " << title << ": " << note << "\n";
   if (const std::string note = time_gap_note(result.contacts); !note.empty())
     messages_of(o) << "extwrench: note: " << title << ": " << note << "\n";
-  if (const std::string range = joint_range.note(); !range.empty())
+  if (const std::string range = joint_range.note(); o.warn_joint_range && !range.empty())
     messages_of(o) << "extwrench: warning: " << title << ": " << range << "\n";
   own_outputs.keep();
   return result;

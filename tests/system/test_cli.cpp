@@ -275,6 +275,23 @@ TEST_F(Cli, SimulateNotesWhatAnEarlierRunLeftInItsDirectory) {
   EXPECT_TRUE(fs::exists(path("sweep/seed_1/ft_k25/estimates.csv")));  // the user's to remove
 }
 
+// The simulator does not enforce joint limits: a motion past them (a tuning scenario's amplitude
+// carried to a real arm) is noted once per seed, not warned about by every scheme as degrees.
+TEST_F(Cli, SimulateNotesAMotionPastTheJointLimits) {
+  write_text(path("far.yaml"), "robot: " + (kModels / "paper_arm.urdf").string() +
+                                   "\nseeds: [1]\nduration: 0.05\ntrajectory: {offset: [0, 2.5, "
+                                   "0, 0, 0, 0, 0]}\nschemes:\n  ft: {sensor: {type: ft}}\n");
+  const RunResult r = run("simulate --no-figures '" + path("far.yaml").string() + "' --out '" +
+                          path("far").string() + "'");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(contains(r.err, "note: q2 (joint 'joint2') reaches 2.5")) << r.err;
+  EXPECT_TRUE(
+      contains(r.err, "beyond its limits [-2.0944, 2.0944]: the simulator does not stop it"))
+      << r.err;
+  EXPECT_FALSE(contains(r.err, "degrees")) << r.err;
+  EXPECT_FALSE(contains(r.err, "q1 (joint")) << r.err;
+}
+
 // ---- info --------------------------------------------------------------------------------
 
 /// Link names and masses read from the URDF text by the test (independent of our parser).

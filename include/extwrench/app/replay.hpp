@@ -51,6 +51,9 @@ struct ReplayOptions {
   bool ignore_extra_joint_columns = false;
   /// Warn on stderr when most contact samples carry `disagreement` (wrong sensor pose...).
   bool warn_disagreement = true;
+  /// Warn on stderr about joint positions far outside the model's limits (a log in degrees);
+  /// `simulate` notes a motion past the limits itself.
+  bool warn_joint_range = true;
   /// Note on stderr when a log without truth has contacts that look like the model's error
   /// (frequent_alarms_note): `estimate` sets it when the configuration includes no calibration.
   bool note_frequent_alarms = false;
