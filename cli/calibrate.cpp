@@ -45,9 +45,8 @@ void run_calibrate(const CalibrateOptions& opt) {
               "calibrate writes CALIB.yaml to a file, not to standard output (its report goes "
               "there); give a file path");
   check_output_file(opt.out, "--out", {opt.config, opt.log});
-  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
-  load.root_body = opt.root_body;
-  load.tip_body = opt.tip_body;
+  const LoadOptions load =
+      robot_load_options(opt.package_path, opt.lock, opt.root_body, opt.tip_body);
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   const auto start = std::chrono::steady_clock::now();
   const CalibrateLogResult run =

@@ -54,10 +54,12 @@ void add_lock_option(CLI::App& sub, std::vector<std::string>& locks);
 /// (LoadOptions::root_body, tip_body; root_body, tip_body in a configuration or scenario).
 void add_chain_options(CLI::App& sub, std::string& root_body, std::string& tip_body);
 
-/// LoadOptions from --package-path and --lock; throws UsageError for a --lock that is not
-/// NAME=VALUE with a finite number, or a joint locked twice.
+/// LoadOptions from --package-path, --lock, --root-body and --tip-body; throws UsageError for a
+/// --lock that is not NAME=VALUE with a finite number, or a joint locked twice.
 [[nodiscard]] LoadOptions robot_load_options(const std::vector<std::filesystem::path>& package_path,
-                                             const std::vector<std::string>& locks);
+                                             const std::vector<std::string>& locks,
+                                             const std::string& root_body,
+                                             const std::string& tip_body);
 
 /// Loads a URDF or DH YAML with those options (package directories, ROS_PACKAGE_PATH, locks).
 [[nodiscard]] RobotDescription load_robot_file(const std::filesystem::path& path,

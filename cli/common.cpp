@@ -70,9 +70,12 @@ void add_chain_options(CLI::App& sub, std::string& root_body, std::string& tip_b
 }
 
 LoadOptions robot_load_options(const std::vector<std::filesystem::path>& package_path,
-                               const std::vector<std::string>& locks) {
+                               const std::vector<std::string>& locks, const std::string& root_body,
+                               const std::string& tip_body) {
   LoadOptions options;
   options.package_path = package_path;
+  options.root_body = root_body;
+  options.tip_body = tip_body;
   for (const std::string& text : locks) {
     const auto eq = text.find('=');
     const auto value = eq == std::string::npos ? std::nullopt : parse_number(text.substr(eq + 1));

@@ -50,9 +50,7 @@ void run_dynamics(const DynamicsOptions& opt) {
   if (opt.out != "-") check_output_file(out_path, "--out", {opt.robot, opt.in});
 
   // Inverse dynamics needs no geometry: a mesh that cannot be found (package://) is no error here.
-  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
-  load.root_body = opt.root_body;
-  load.tip_body = opt.tip_body;
+  LoadOptions load = robot_load_options(opt.package_path, opt.lock, opt.root_body, opt.tip_body);
   load.load_meshes = false;
   const RobotDescription robot = load_robot_file(opt.robot, load);
   const Model& model = robot.model;

@@ -189,9 +189,8 @@ void run_estimate(const EstimateOptions& opt) {
   if (!(opt.plot_points >= 10)) throw UsageError("--plot-points must be at least 10");
   const LogInputs inputs = expand_logs(opt.logs);
   const std::vector<std::filesystem::path> dirs = output_dirs(inputs, opt.out);
-  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
-  load.root_body = opt.root_body;
-  load.tip_body = opt.tip_body;
+  const LoadOptions load =
+      robot_load_options(opt.package_path, opt.lock, opt.root_body, opt.tip_body);
   const EstimatorConfig config = load_estimator_config(opt.config, load);
   for (const auto& log : inputs.logs) check_input_file(log, "log");
   common.note_frequent_alarms = config.calibration_path.empty();

@@ -76,9 +76,8 @@ std::string limits_text(const Joint& j) {
 }
 
 void run_info(const InfoOptions& opt) {
-  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
-  load.root_body = opt.root_body;
-  load.tip_body = opt.tip_body;
+  const LoadOptions load =
+      robot_load_options(opt.package_path, opt.lock, opt.root_body, opt.tip_body);
   const RobotDescription robot = load_robot_file(opt.robot, load);
   const Model& model = robot.model;
   std::ostringstream out;

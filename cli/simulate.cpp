@@ -91,9 +91,8 @@ void print_scheme(const Scenario& scenario, const SchemeSpec& scheme,
 void run_simulate(const SimulateOptions& opt) {
   refuse_dash(opt.out, "--out",
               "simulate writes a directory of files, not standard output; give a directory path");
-  LoadOptions load = robot_load_options(opt.package_path, opt.lock);
-  load.root_body = opt.root_body;
-  load.tip_body = opt.tip_body;
+  const LoadOptions load =
+      robot_load_options(opt.package_path, opt.lock, opt.root_body, opt.tip_body);
   const Scenario scenario = load_scenario(opt.scenario, load);
   const Pose& X_WS = scenario.simulation.sensor.X_WS;
   const bool default_pose =

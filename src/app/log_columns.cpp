@@ -58,7 +58,7 @@ void check_sensor_columns(const LogReader& reader, SensorType sensor) {
   }
 }
 
-JointRangeCheck::JointRangeCheck(const Model& model) : model_(&model) {
+JointRangeCheck::JointRangeCheck(const Model& model, Margin margin) : model_(&model) {
   const int n = model.nq();
   for (int i = 1; i <= n; ++i) {
     const Joint& j = model.joints[static_cast<std::size_t>(i)];
@@ -66,12 +66,11 @@ JointRangeCheck::JointRangeCheck(const Model& model) : model_(&model) {
     // No limits (continuous), or none worth the name (lower = upper = 0: a URDF's default, an
     // exporter's placeholder): nothing to check against.
     const bool checked = std::isfinite(range) && range > 0.0;
-    const double margin = checked ? std::max(0.1 * range, 0.1) : 0.0;
-    lower_.push_back(checked ? j.lower - margin : -std::numeric_limits<double>::infinity());
-    upper_.push_back(checked ? j.upper + margin : std::numeric_limits<double>::infinity());
+    const double widen = margin == Margin::kLog ? std::max(0.1 * range, 0.1) : 0.0;
+    lower_.push_back(checked ? j.lower - widen : -std::numeric_limits<double>::infinity());
+    upper_.push_back(checked ? j.upper + widen : std::numeric_limits<double>::infinity());
   }
-  outside_.assign(lower_.size(), 0);
-  furthest_.assign(lower_.size(), 0.0);
+  excursions_.resize(lower_.size());
 }
 
 void JointRangeCheck::add(const Sample& sample) noexcept {
@@ -79,33 +78,33 @@ void JointRangeCheck::add(const Sample& sample) noexcept {
   if (static_cast<std::size_t>(sample.q.size()) != lower_.size()) return;
   for (std::size_t i = 0; i < lower_.size(); ++i) {
     const double q = sample.q[static_cast<Eigen::Index>(i)];
-    if (q >= lower_[i] && q <= upper_[i]) continue;
-    ++outside_[i];
-    const double beyond = q < lower_[i] ? lower_[i] - q : q - upper_[i];
-    const double before =
-        furthest_[i] < lower_[i] ? lower_[i] - furthest_[i] : furthest_[i] - upper_[i];
-    if (outside_[i] == 1 || beyond > before) furthest_[i] = q;
+    const double beyond = q < lower_[i] ? lower_[i] - q : q > upper_[i] ? q - upper_[i] : 0.0;
+    if (!(beyond > 0.0)) continue;
+    Excursion& e = excursions_[i];
+    ++e.rows;
+    if (beyond > e.beyond) e = {e.rows, beyond, q, sample.t};
   }
 }
 
 bool JointRangeCheck::mostly_outside() const noexcept {
-  return std::any_of(outside_.begin(), outside_.end(), [&](long o) { return 2 * o > rows_; });
+  return std::any_of(excursions_.begin(), excursions_.end(),
+                     [&](const Excursion& e) { return 2 * e.rows > rows_; });
 }
 
 std::string JointRangeCheck::note() const {
-  std::size_t worst = lower_.size();
-  for (std::size_t i = 0; i < lower_.size(); ++i) {
-    if (outside_[i] > 0 && (worst == lower_.size() || outside_[i] > outside_[worst])) worst = i;
-  }
-  if (worst == lower_.size()) return {};
-  long joints = 0;
-  for (const long o : outside_) joints += o > 0 ? 1 : 0;
+  const auto most =
+      std::max_element(excursions_.begin(), excursions_.end(),
+                       [](const Excursion& a, const Excursion& b) { return a.rows < b.rows; });
+  if (most == excursions_.end() || most->rows == 0) return {};
+  const auto worst = static_cast<std::size_t>(most - excursions_.begin());
+  const auto joints = std::count_if(excursions_.begin(), excursions_.end(),
+                                    [](const Excursion& e) { return e.rows > 0; });
   const Joint& j = model_->joints[worst + 1];
   char shown[32];
-  std::snprintf(shown, sizeof shown, "%.4g", furthest_[worst]);
+  std::snprintf(shown, sizeof shown, "%.4g", most->q);
   return "q" + std::to_string(worst + 1) + " (joint '" + j.name + "') lies outside its limits [" +
          format_number(j.lower) + ", " + format_number(j.upper) +
-         "] (by more than a tenth of the range) on " + std::to_string(outside_[worst]) + " of " +
+         "] (by more than a tenth of the range) on " + std::to_string(most->rows) + " of " +
          std::to_string(rows_) + " rows (up to " + std::string(shown) + ")" +
          (joints > 1 ? ", and " + std::to_string(joints - 1) + " more joint" +
                            (joints > 2 ? "s" : "") + " too"

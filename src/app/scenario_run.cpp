@@ -25,6 +25,7 @@
 #include "extwrench/io/text_quoting.hpp"
 #include "extwrench/io/urdf_writer.hpp"
 #include "extwrench/sim/perturb.hpp"
+#include "log_columns.hpp"
 #include "progress.hpp"
 #include "summary_figure.hpp"
 
@@ -175,20 +176,10 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   for (sim::ForceProfile& f : forces) f.resolve(model);
   std::vector<bool> pending(forces.size(), !push_point_advice.empty());
   // The simulator does not enforce joint limits: a motion past them is noted (a real arm stops).
-  const int n = model.nq();
-  std::vector<double> beyond(static_cast<std::size_t>(n), 0.0), beyond_q(beyond), beyond_t(beyond);
+  detail::JointRangeCheck joint_range(model, detail::JointRangeCheck::Margin::kNone);
   while (simulator.next(sample)) {
     log.write(sample);
-    for (int i = 0; i < n; ++i) {
-      const Joint& j = model.joints[static_cast<std::size_t>(i + 1)];
-      const double q = sample.q[i];
-      const double out = q > j.upper ? q - j.upper : q < j.lower ? j.lower - q : 0.0;
-      if (out > beyond[static_cast<std::size_t>(i)]) {
-        beyond[static_cast<std::size_t>(i)] = out;
-        beyond_q[static_cast<std::size_t>(i)] = q;
-        beyond_t[static_cast<std::size_t>(i)] = sample.t;
-      }
-    }
+    joint_range.add(sample);
     for (std::size_t k = 0; k < pending.size(); ++k) {
       const sim::ForceProfile& profile = forces[k];
       if (!pending[k] || profile.scale(sample.t) == 0.0) continue;
@@ -219,16 +210,17 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   progress.done();
   log.close();
   outputs.commit(log_path);
-  for (int i = 0; i < n; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (beyond[k] <= 0.0) continue;
+  const auto& excursions = joint_range.excursions();
+  for (std::size_t k = 0; k < excursions.size(); ++k) {
+    const auto& e = excursions[k];
+    if (e.rows == 0) continue;
     const Joint& j = model.joints[k + 1];
     char text[320];
     std::snprintf(text, sizeof text,
-                  "q%d (joint '%s') reaches %.4g at t = %.4g s, %.3g beyond its limits [%g, %g]: "
+                  "q%zu (joint '%s') reaches %.4g at t = %.4g s, %.3g beyond its limits [%g, %g]: "
                   "the simulator does not stop it, a real arm would (trajectory: amplitude, "
                   "offset)",
-                  i + 1, j.name.c_str(), beyond_q[k], beyond_t[k], beyond[k], j.lower, j.upper);
+                  k + 1, j.name.c_str(), e.q, e.t, e.beyond, j.lower, j.upper);
     r.notes.emplace_back(text);
   }
 }

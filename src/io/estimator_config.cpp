@@ -350,11 +350,7 @@ void read_robot(const YamlReader& rd, const YAML::Node& root, const fs::path& so
   if (root["locked_joints"])
     rd.locked_joints(root["locked_joints"], "locked_joints", robot_options);
   cfg.locked_joints = robot_options.locked_joints;
-  // The command line's --root-body, --tip-body win over the file's, as --lock does.
-  if (root["root_body"] && robot_options.root_body.empty())
-    robot_options.root_body = rd.string(root["root_body"], "root_body");
-  if (root["tip_body"] && robot_options.tip_body.empty())
-    robot_options.tip_body = rd.string(root["tip_body"], "tip_body");
+  rd.chain(root, robot_options);
   cfg.root_body = robot_options.root_body;
   cfg.tip_body = robot_options.tip_body;
   try {

@@ -224,11 +224,7 @@ void parse_robot(const YamlReader& y, const YAML::Node& root, const LoadOptions&
     y.fail(root["robot"], "robot", "no such file '" + s.robot_path.string() + "'");
   LoadOptions options = robot_options;
   if (root["locked_joints"]) y.locked_joints(root["locked_joints"], "locked_joints", options);
-  // An MJCF scene's chain; --root-body, --tip-body win.
-  if (root["root_body"] && options.root_body.empty())
-    options.root_body = y.string(root["root_body"], "root_body");
-  if (root["tip_body"] && options.tip_body.empty())
-    options.tip_body = y.string(root["tip_body"], "tip_body");
+  y.chain(root, options);
   s.robot = load_robot(s.robot_path, options);
   s.robot_options = options;
 }

@@ -341,7 +341,6 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        "seeds[0]: expected a whole number >= 0, got 1.5"},
       {"exclude_reversed", kGoodScenario + "metrics: {exclude: [[2, 1]]}\n",
        "metrics.exclude[0]: expected [from, to] with from < to"},
-
       {"scheme_robot", replace(kGoodScenario, "ft: {sensor", "ft: {robot: x.urdf, sensor"),
        "schemes.ft.robot: schemes use the scenario's perturbed model"},
       {"scheme_without_sensor", replace(kGoodScenario, "ft: {sensor: {type: ft}, ", "ft: {"),

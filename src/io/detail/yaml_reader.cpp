@@ -287,4 +287,11 @@ void YamlReader::locked_joints(const YAML::Node& node, const std::string& key,
   }
 }
 
+void YamlReader::chain(const YAML::Node& root, LoadOptions& options) const {
+  if (root["root_body"] && options.root_body.empty())
+    options.root_body = string(root["root_body"], "root_body");
+  if (root["tip_body"] && options.tip_body.empty())
+    options.tip_body = string(root["tip_body"], "tip_body");
+}
+
 }  // namespace extwrench::io_detail

@@ -127,6 +127,9 @@ class YamlReader {
   /// `locked_joints: {NAME: VALUE, ...}` [rad | m] added to `options` (entries already there,
   /// from the command line, win) with their file:line as the lock's source.
   void locked_joints(const YAML::Node& node, const std::string& key, LoadOptions& options) const;
+  /// An MJCF scene's chain, `root_body:` and `tip_body:` of the mapping `root`, into `options`
+  /// where it has none (the command line's --root-body, --tip-body win).
+  void chain(const YAML::Node& root, LoadOptions& options) const;
   /// The index of the body named by the scalar.
   [[nodiscard]] int body(const Model& model, const YAML::Node& node, const std::string& key) const;
 
