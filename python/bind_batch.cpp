@@ -8,6 +8,7 @@
 #include "arrays.hpp"
 #include "estimator.hpp"
 #include "extwrench/app/contact_tally.hpp"
+#include "extwrench/app/joint_range.hpp"
 
 namespace extwrench::python {
 namespace {
@@ -313,11 +314,27 @@ py::dict contact_summary_py(const Estimator& source, const py::handle& t, const 
   return d;
 }
 
+/// The note of `extwrench estimate` on positions far outside the limits (degrees, a glitch), for
+/// estimate()'s arrays: "" when there is none.
+std::string joint_range_note(const Estimator& source, const py::handle& t, const py::handle& q) {
+  const RealArray time = real_array(t, "t", 1);
+  const RealArray q_rows = real_array(q, "q", 2);
+  check_shape(q_rows, "q", time.rows, source.nq());
+  JointRangeCheck check(source.config.robot.model);
+  VectorX row(source.nq());
+  for (py::ssize_t k = 0; k < time.rows; ++k) {
+    for (Eigen::Index i = 0; i < row.size(); ++i) row[i] = q_rows.at(k, i);
+    check.add(time.at(k), row);
+  }
+  return check.note();
+}
+
 void bind_batch(py::module_& m) {
   m.def("_estimate", &estimate_batch, py::arg("estimator"), py::arg("t"), py::arg("q"),
         py::arg("dq"), py::arg("tau"), py::arg("reading") = py::none());
   m.def("_contact_summary", &contact_summary_py, py::arg("estimator"), py::arg("t"),
         py::arg("contact"), py::arg("link"), py::arg("flags") = py::none());
+  m.def("_joint_range_note", &joint_range_note, py::arg("estimator"), py::arg("t"), py::arg("q"));
 }
 
 }  // namespace extwrench::python

@@ -92,7 +92,8 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
     With notes, what `extwrench estimate` notes on stderr is an EstimateWarning: contacts that
     look like the model's error (when the configuration includes no calibration), mostly
     flagged 'disagreement', mostly on the base alone (the sensor's sign, pose or bias?), samples
-    more than 50 ms apart on average (t not in seconds?), or a gap in t.
+    more than 50 ms apart on average (t not in seconds?), a gap in t, or positions far outside
+    the joint limits (degrees? a glitch?).
     contact_summary() gives the counts.
     """
     est = _estimator_for(source, reading)
@@ -108,6 +109,9 @@ def estimate(source: Union[ContactEstimator, Robot, Dict[str, Any], str, os.Path
             warnings.warn(summary["time_step_note"], EstimateWarning, stacklevel=2)
         if summary["time_gap_note"]:
             warnings.warn(summary["time_gap_note"], EstimateWarning, stacklevel=2)
+        joint_range = _extwrench._joint_range_note(est, t, q)
+        if joint_range:
+            warnings.warn(joint_range, EstimateWarning, stacklevel=2)
         if summary["note"] and est.calibration_path is None:
             warnings.warn(summary["note"] + "; in Python: extwrench.calibrate(estimator, "
                           "'FREE.csv', out='CALIB.yaml')", EstimateWarning, stacklevel=2)

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "extwrench/app/joint_range.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/calibration_file.hpp"
 #include "extwrench/io/input_file.hpp"
@@ -130,7 +131,7 @@ CalibrateLogResult calibrate_log(const EstimatorConfig& config, const std::files
   }
   // Positions in degrees fit friction and thresholds to nonsense (10 000 N m) without a word:
   // refused; a few rows outside (a glitch) are warned about.
-  detail::JointRangeCheck joint_range(model);
+  JointRangeCheck joint_range(model);
   for (const Sample& s : samples) joint_range.add(s);
   const std::string range = joint_range.note();
   if (joint_range.mostly_outside()) throw Error(log.string() + ": " + range);

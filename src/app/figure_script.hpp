@@ -65,8 +65,12 @@ struct PlotContext {
   std::vector<char> present;             // per column: some value is finite
   std::vector<char> positive;            // per column: some value is > 0 (log scales)
   std::vector<std::string> joint_units;  // per joint: "N m" (revolute) or "N" (prismatic)
-  double t_begin = 0.0, t_end = 1.0;
+  double t_begin = 0.0, t_end = 1.0;     // the time axis, less t_offset [s]
+  double t_offset = 0.0;                 // subtracted from the log's t (an epoch's), or 0 [s]
 };
+
+// The time axis's label: "t [s]", or "t − 1765140000 [s]" for a log stamped in epoch seconds.
+std::string time_label(const PlotContext& c);
 
 struct Figure {
   std::string name;

@@ -13,6 +13,7 @@
 
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/io/number_text.hpp"
 #include "figure_script.hpp"
 #include "robot3d.hpp"
 
@@ -26,6 +27,11 @@ std::string enhanced(const std::string& text) {
     out += c;
   }
   return out;
+}
+
+std::string time_label(const PlotContext& c) {
+  if (c.t_offset == 0.0) return "'t [s]'";
+  return gnuplot_quote("t − " + format_number(c.t_offset) + " [s]");
 }
 
 void plot_series(std::ostream& s, const PlotContext& c, const std::vector<Series>& series,
@@ -64,8 +70,8 @@ constexpr const char* kKey = "set key outside right top vertical samplen 2\n";
 std::string joints_script(const PlotContext& c, const Figure& f) {
   std::ostringstream s;
   s << gnuplot_preamble(f.output, c.format, 1100, 700) << kKey << "set title "
-    << gnuplot_quote("Joint positions — " + enhanced(c.title))
-    << "\nset xlabel 't [s]'\nset ylabel 'q_i [rad]'\n";
+    << gnuplot_quote("Joint positions — " + enhanced(c.title)) << "\nset xlabel " << time_label(c)
+    << "\nset ylabel 'q_i [rad]'\n";
   std::vector<Series> series;
   for (int i = 0; i < c.n; ++i) {
     const std::string lt = " lt " + std::to_string(i + 1);
@@ -92,7 +98,7 @@ std::string force_script(const PlotContext& c, const Figure& f) {
                  {kFt + k, "with lines lw 2 dt 2 lc rgb '#d62728'", "true"}},
                 "no force estimated (no contact detected)");
   }
-  s << "set xlabel 't [s]'\n";
+  s << "set xlabel " << time_label(c) << "\n";
   if (c.truth) {
     s << "set ylabel '|F_{est} - F| [N]'\n";
     plot_series(s, c, {{kErrF, "with lines lw 2 lc rgb '#2ca02c'", "force error"}},
@@ -113,7 +119,7 @@ std::string line_point_script(const PlotContext& c, const Figure& f) {
     << "\nset lmargin 10\nset rmargin 22\n";
   for (int k = 0; k < 3; ++k) {
     s << "set ylabel 'p_" << kAxis[k] << " [m]'\n"
-      << (k == 2 ? "set xlabel 't [s]'\n" : "unset xlabel\n");
+      << (k == 2 ? "set xlabel " + time_label(c) + "\n" : "unset xlabel\n");
     plot_series(s, c,
                 {{kL + k, "with linespoints lw 2 pt 7 ps 0.3 lc rgb '#1f77b4'", "estimated p̂"},
                  {kPt + k, "with lines lw 2 dt 2 lc rgb '#d62728'", "true point"}},
@@ -158,8 +164,8 @@ std::string condition_script(const PlotContext& c, const Figure& f, const Envelo
                              double max_condition) {
   std::ostringstream s;
   s << gnuplot_preamble(f.output, c.format, 1100, 600) << kKey << "set title "
-    << gnuplot_quote("Condition number — " + enhanced(c.title))
-    << "\nset xlabel 't [s]'\nset ylabel 'σ_{max} / σ_{min}'\n";
+    << gnuplot_quote("Condition number — " + enhanced(c.title)) << "\nset xlabel " << time_label(c)
+    << "\nset ylabel 'σ_{max} / σ_{min}'\n";
   const std::string spans = flagged_spans(rows, kIll, kDampedColour, c.t_begin, c.t_end);
   s << spans;
   std::string extra;
@@ -204,7 +210,7 @@ std::string residual_script(const PlotContext& c, const Figure& f, const Envelop
     const std::string j = std::to_string(i + 1);
     const int threshold = joint_col(kThreshold, c.n, i);
     s << "set ylabel 'r_{" << j << "} [" << c.joint_units[static_cast<std::size_t>(i)] << "]'\n"
-      << (i + 1 == panels ? "set xlabel 't [s]'\n" : "unset xlabel\n");
+      << (i + 1 == panels ? "set xlabel " + time_label(c) + "\n" : "unset xlabel\n");
     std::string extra;
     // −τ_thr, and undrawn curves at ±1.15 τ_thr so that autoscale keeps both lines inside the
     // frame (on a quiet joint they would lie on its edges).
@@ -224,7 +230,7 @@ std::string residual_script(const PlotContext& c, const Figure& f, const Envelop
         "no residual (the estimator never started)", false, extra);
   }
   if (force_panel) {
-    s << "set ylabel '‖F_{ext}‖ [N]'\nset xlabel 't [s]'\n";
+    s << "set ylabel '‖F_{ext}‖ [N]'\nset xlabel " << time_label(c) << "\n";
     plot_series(s, c,
                 {{kBaseForce, "with lines lw 1.5 lc rgb '#1f77b4'", "‖F_{ext}‖, base sensor"},
                  {kForceThreshold, "with lines lw 1 lc rgb 'black'", "F_{min}"}},
@@ -321,7 +327,13 @@ void FigureRecorder::add(const Sample& sample, const ContactEstimate& estimate,
                          const ContactDetector& detector, double true_condition) {
   double* r = row_.data();
   const int n = model_.nq();
-  r[kT] = sample.t;
+  // gnuplot cannot draw an axis 6 s long at 1.8e9 s (its range is "empty" below a relative
+  // 1e-8): a log stamped in epoch seconds is drawn from its first whole second.
+  if (!started_) {
+    t_offset_ = std::abs(sample.t) >= kEpochTime ? std::floor(sample.t) : 0.0;
+    started_ = true;
+  }
+  r[kT] = sample.t - t_offset_;
   estimate_columns(sample, estimate, r);
   truth_columns(sample, estimate, true_condition, r);
   detection_columns(sample, estimate, detector, r);
@@ -402,7 +414,8 @@ DrawnFigures FigureRecorder::draw(const FigureOptions& o, OutputFiles& parent) c
   const std::filesystem::path data = o.dir / "plot_data.txt";
   rows_.write(outputs.stage(data));
   outputs.commit(data);
-  const PlotContext c = context_of(o, rows_, model_, truth_);
+  PlotContext c = context_of(o, rows_, model_, truth_);
+  c.t_offset = t_offset_;
   std::vector<Figure> figures{figure(c, "joints"), figure(c, "force"), figure(c, "line_point"),
                               figure(c, "condition"), figure(c, "residual")};
   outputs.write_text(figures[0].script, joints_script(c, figures[0]));

@@ -76,7 +76,10 @@ class FigureRecorder {
   EnvelopeDecimator rows_;   // the time plots
   Decimator snapshot_rows_;  // whole rows (real configurations) for the 3-D view
   std::vector<double> row_;  // the row being filled
-  Data data_;                // kinematics for cond(J) of the contact links
+  bool started_ = false;     // a first sample was added (it sets t_offset_)
+  double t_offset_ = 0.0;    // subtracted from t on the time axes (an epoch's seconds), or 0
+  static constexpr double kEpochTime = 1e6;  // [s]: 11.6 days, a clock's epoch and not a run's
+  Data data_;                                // kinematics for cond(J) of the contact links
   VectorX q_d_, dq_d_, ddq_d_;
 };
 

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "extwrench/app/joint_range.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/io/log.hpp"
 #include "figures.hpp"
@@ -163,7 +164,7 @@ ReplayResult replay_log(const Model& model, const GeometryModel& geometry,
   const std::string title = title_of(o);
   detail::ProgressLine progress(o.progress, 1024, std::chrono::milliseconds(250));
   ContactTally contacts(model.num_bodies());
-  detail::JointRangeCheck joint_range(model);
+  JointRangeCheck joint_range(model);
   const std::string log_name = reader.name();  // the reader belongs to its thread from here on
   // cond(J) of the true link, for the figures, on the reader's thread when there is one.
   detail::RowHook true_condition;

@@ -244,7 +244,7 @@ std::string robot3d_script(const PlotContext& c, const Figure& f, const Robot3dI
     << " right top vertical samplen 2 spacing 1.3\n";
   for (std::size_t k = 0; k < shots.size(); ++k) {
     char t[64];
-    std::snprintf(t, sizeof t, "t = %.3f s", in.rows.row(shots[k])[kT]);
+    std::snprintf(t, sizeof t, "t = %.3f s", in.rows.row(shots[k])[kT] + c.t_offset);
     const auto has = [&](bool mesh) {
       if (in.geometry == nullptr) return false;
       return std::any_of(

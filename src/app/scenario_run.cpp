@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "extwrench/app/jobs.hpp"
+#include "extwrench/app/joint_range.hpp"
 #include "extwrench/core/error.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/estimation/isolation.hpp"
@@ -176,7 +177,7 @@ void simulate_seed(const Scenario& s, const Model& believed, int singular_body, 
   for (sim::ForceProfile& f : forces) f.resolve(model);
   std::vector<bool> pending(forces.size(), !push_point_advice.empty());
   // The simulator does not enforce joint limits: a motion past them is noted (a real arm stops).
-  detail::JointRangeCheck joint_range(model, detail::JointRangeCheck::Margin::kNone);
+  JointRangeCheck joint_range(model, JointRangeCheck::Margin::kNone);
   while (simulator.next(sample)) {
     log.write(sample);
     joint_range.add(sample);

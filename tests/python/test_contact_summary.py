@@ -148,3 +148,35 @@ def test_a_log_in_milliseconds_gets_the_time_step_note(paper_run, cli, tmp_path)
                                           "--log", str(ms), "--out", "ms"])
     # (the title is the configuration's scheme, as for the other notes)
     assert "extwrench: note: ft: " + summary["time_step_note"] + "\n" in stderr, stderr
+
+
+def test_a_log_in_degrees_gets_the_commands_joint_range_warning(paper_run, cli, tmp_path):
+    """The paper's log with its positions written in degrees: estimate() warns that a joint lies
+    outside its limits on most rows, with the text the command prints for the same file; the
+    log in radians (above) gets no such word."""
+    run = paper_run["dir"]
+    config = run / "ft" / "config.yaml"
+    est = extwrench.ContactEstimator(None, config)
+    lines = (run / "log.csv").read_text().splitlines()
+    head = lines[0].split(",")
+    q_columns = [i for i, name in enumerate(head) if name[0] == "q" and name[1:].isdigit()]
+    assert len(q_columns) == est.nq
+    rows = [line.split(",") for line in lines[1:2001]]
+    for row in rows:
+        for i in q_columns:
+            row[i] = "%.12g" % np.degrees(float(row[i]))
+    degrees = tmp_path / "log_degrees.csv"
+    degrees.write_text("\n".join([lines[0]] + [",".join(row) for row in rows]) + "\n")
+    log = extwrench.read_log(degrees, est)
+    with pytest.warns(extwrench.EstimateWarning, match="in degrees") as caught:
+        estimate(est, log)
+    messages = [str(w.message) for w in caught if "in degrees" in str(w.message)]
+    assert len(messages) == 1 and "outside its limits" in messages[0]
+    _, stderr = cli_lines(cli, tmp_path, ["estimate", "--no-figures", "--config", str(config),
+                                          "--log", str(degrees), "--out", "degrees"])
+    assert "extwrench: warning: ft: " + messages[0] + "\n" in stderr, stderr
+    radians = extwrench.read_log(run / "log.csv", est)
+    with warnings.catch_warnings(record=True) as quiet:
+        warnings.simplefilter("always")
+        estimate(est, radians)
+    assert not [w for w in quiet if "outside its limits" in str(w.message)]
