@@ -11,6 +11,7 @@
 
 #include "extwrench/app/joint_range.hpp"
 #include "extwrench/core/error.hpp"
+#include "extwrench/core/time_step.hpp"
 #include "extwrench/io/calibration_file.hpp"
 #include "extwrench/io/input_file.hpp"
 #include "extwrench/io/log.hpp"
@@ -201,7 +202,7 @@ std::string calibration_report(const CalibrateLogResult& run, bool in_contact) {
       out << " + " << cell(j.threshold_per_speed, 0) << " |dq| (constant would be "
           << cell(j.threshold_constant, 0) << ")";
     if (j.threshold_from_max)
-      out << " (largest residual, at t = " << cell(j.max_after_t, 0) << " s)\n";
+      out << " (largest residual, at t = " << time_text(j.max_after_t) << " s)\n";
     else
       out << " (gaussian)\n";
   }

@@ -138,13 +138,12 @@ std::string time_gap_note(const ContactTally& tally) {
   if (tally.rows < 3) return {};
   const double mean = tally.duration() / static_cast<double>(tally.rows - 1);
   if (!(tally.longest_step > kGap && tally.longest_step > kTimesTheMean * mean)) return {};
-  char text[256];
-  std::snprintf(text, sizeof text,
-                "the log has a gap: %.4g s between t = %.6g and %.6g s, against %.3g s per "
-                "step on average",
-                tally.longest_step, tally.longest_step_at - tally.longest_step,
-                tally.longest_step_at, mean);
-  return std::string(text) +
+  char gap[32], step[32];
+  std::snprintf(gap, sizeof gap, "%.4g", tally.longest_step);
+  std::snprintf(step, sizeof step, "%.3g", mean);
+  return std::string("the log has a gap: ") + gap +
+         " s between t = " + time_text(tally.longest_step_at - tally.longest_step) + " and " +
+         time_text(tally.longest_step_at) + " s, against " + step + " s per step on average" +
          ". The observer integrates it as one step, so its residual jumps there and the "
          "estimates after it settle again; replay the parts before and after it as two logs";
 }

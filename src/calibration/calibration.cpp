@@ -42,7 +42,7 @@ constexpr double kMinThreshold = 1e-6;
 void check_samples(const std::vector<Sample>& samples, int n, bool known_external_torque) {
   for (std::size_t k = 0; k < samples.size(); ++k) {
     const Sample& s = samples[k];
-    const std::string where = "sample " + std::to_string(k) + " (t = " + number_text(s.t, 6) + ")";
+    const std::string where = "sample " + std::to_string(k) + " (t = " + time_text(s.t) + ")";
     if (known_external_torque && !s.has_true_tau_ext) {
       throw Error(where +
                   ": no known external torque (true_tau_ext1..n) for a calibration in contact");
@@ -361,8 +361,8 @@ void warn_unexplained_torque(const std::vector<Sample>& samples, const std::vect
     cal.warnings.push_back(
         "joint " + std::to_string(i + 1) + ": after calibration the residual's RMS is " +
         std::to_string(static_cast<int>(std::lround(100.0 * share))) +
-        " % of the measured torque's over [" + number_text(cal.t_begin, 6) + ", " +
-        number_text(cal.t_end, 6) +
+        " % of the measured torque's over [" + time_text(cal.t_begin) + ", " +
+        time_text(cal.t_end) +
         "] s: the model explains little of it; a contact during most of the log (the fit "
         "cannot tell it from the robot), or a wrong model. With a known external torque "
         "(a force plate), calibrate in contact (--known-torque)");
@@ -675,7 +675,7 @@ Calibration calibrate_with(const Model& model, const EstimatorOptions& options,
     const auto left = static_cast<int>(std::count(use.begin(), use.end(), 1));
     std::string list;
     for (const SuspectWindow& w : cal.suspect_windows)
-      list += " [" + number_text(w.t_begin, 6) + ", " + number_text(w.t_end, 6) + "] s (joint " +
+      list += " [" + time_text(w.t_begin) + ", " + time_text(w.t_end) + "] s (joint " +
               std::to_string(w.joint) + ", " + number_text(w.peak, 3) + " N m)";
     if (used - left > o.max_contact_fraction * used || left < parameters) {
       std::string hint = "; record free motion only";

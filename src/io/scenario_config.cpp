@@ -152,7 +152,10 @@ void parse_joint_torque(const YamlReader& y, const YAML::Node& j, const Scenario
   }
   if (const YAML::Node f = j["friction"])
     torque.friction = io_detail::read_friction_mapping(y, f, s.robot.model.nq(), k + ".friction");
-  y.set_number_in(j, k, "noise", non_negative(), torque.noise);
+  if (const YAML::Node noise = j["noise"]) {
+    const Range range = non_negative();
+    torque.noise = y.vector(noise, k + ".noise", s.robot.model.nq(), &range);
+  }
 }
 
 void parse_sensors(const YamlReader& y, const YAML::Node& node, Scenario& s) {

@@ -55,8 +55,14 @@ void JointSensor::measure(double t, const VectorX& q, const VectorX& dq, VectorX
 
 void JointTorqueModel::validate(int n, const std::string& where) const {
   if (friction) validate_friction(*friction, n, where);
-  if (!(noise >= 0.0) || !std::isfinite(noise))
-    throw Error(where + ".noise: expected a finite value >= 0");
+  if (noise.size() != 0 && noise.size() != n) {
+    throw Error(where + ".noise: expected " + std::to_string(n) + " values (one per joint), got " +
+                std::to_string(noise.size()));
+  }
+  for (Eigen::Index i = 0; i < noise.size(); ++i) {
+    if (!(noise[i] >= 0.0) || !std::isfinite(noise[i]))
+      throw Error(where + ".noise[" + std::to_string(i) + "]: expected a finite value >= 0");
+  }
 }
 
 }  // namespace extwrench::sim

@@ -122,8 +122,10 @@ void Simulator::add_joint_torque_terms(VectorX& tau) noexcept {
     friction_torque(f, dq_, presliding_state_, tau_friction_);
     tau += tau_friction_;
   }
-  if (jt.noise > 0.0)
-    for (Eigen::Index i = 0; i < tau.size(); ++i) tau[i] += jt.noise * torque_noise_.normal();
+  // One draw per joint and sample whatever σ_i (a joint with σ_i = 0 included), so that the
+  // other joints' noise does not depend on which are quiet.
+  if (jt.noise.size() == tau.size())
+    for (Eigen::Index i = 0; i < tau.size(); ++i) tau[i] += jt.noise[i] * torque_noise_.normal();
 }
 
 bool Simulator::next(Sample& out) {

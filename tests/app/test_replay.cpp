@@ -22,6 +22,7 @@
 #include "extwrench/app/replay.hpp"
 #include "extwrench/app/scenario_run.hpp"
 #include "extwrench/core/error.hpp"
+#include "extwrench/core/time_step.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/log.hpp"
@@ -280,6 +281,11 @@ TEST_F(Replay, MalformedScenariosAreErrorsNamingLineAndKey) {
        "trajectory.speed: unknown key"},
       {"joint_torque_noise", kGoodScenario + "sensors: {joint_torque: {noise: -1}}\n",
        "sensors.joint_torque.noise: expected a value >= 0, got -1"},
+      {"joint_torque_noise_size", kGoodScenario + "sensors: {joint_torque: {noise: [0.1, 0.2]}}\n",
+       ":9: sensors.joint_torque.noise: expected 7 values (or one for all), got 2"},
+      {"joint_torque_noise_item",
+       kGoodScenario + "sensors: {joint_torque: {noise: [0.1, 0.2, 0.3, 0.4, 0.5, -0.6, 0.7]}}\n",
+       "sensors.joint_torque.noise[5]: expected a value >= 0, got -0.6"},
       {"joint_torque_friction_size",
        kGoodScenario + "sensors: {joint_torque: {friction: {viscous: [1, 2]}}}\n",
        ":9: sensors.joint_torque.friction.viscous: expected 7 values (or one for all), got 2"},
@@ -423,6 +429,23 @@ TEST_F(Replay, ScenarioNumbersMayBeInfiniteWhereAFiniteValueIsNotRequired) {
               (void)load_scenario(dir / "s.yaml");
             }).find("duration: expected a value > 0, got inf"),
             std::string::npos);
+}
+
+// sensors.joint_torque.noise: one σ for every joint, or one per joint (a real arm's wrist is
+// quieter than its shoulder).
+TEST_F(Replay, JointTorqueNoiseIsOneForAllOrOnePerJoint) {
+  const fs::path dir = temp_dir("torque_noise");
+  write_text(dir / "s.yaml", kGoodScenario + "sensors: {joint_torque: {noise: 0.05}}\n");
+  EXPECT_EQ(load_scenario(dir / "s.yaml").simulation.joint_torque.noise,
+            VectorX::Constant(7, 0.05));
+  write_text(
+      dir / "s.yaml",
+      kGoodScenario + "sensors: {joint_torque: {noise: [0.3, 0.3, 0.2, 0.2, 0.05, 0.05, 0]}}\n");
+  VectorX expected(7);
+  expected << 0.3, 0.3, 0.2, 0.2, 0.05, 0.05, 0.0;
+  EXPECT_EQ(load_scenario(dir / "s.yaml").simulation.joint_torque.noise, expected);
+  write_text(dir / "s.yaml", kGoodScenario);
+  EXPECT_EQ(load_scenario(dir / "s.yaml").simulation.joint_torque.noise.size(), 0);
 }
 
 TEST_F(Replay, SchemeWithABadEstimatorKeyFailsBeforeSimulatingAndNamesTheScheme) {
@@ -783,9 +806,9 @@ TEST(TimeStepNote, NamesSecondsForSamplesMoreThan50msApart) {
 // A log with a hole in it (a 1 s gap in a 1 kHz log, the review's) is noted with the times; a
 // steady log, a slow one and jitter are not.
 TEST(TimeGapNote, NamesTheLongestStepWhenItIsAGap) {
-  const auto tally = [](long rows, double step, long gap_after, double gap) {
+  const auto tally = [](long rows, double step, long gap_after, double gap, double start = 0.0) {
     ContactTally t(8);
-    double time = 0.0;
+    double time = start;
     for (long k = 0; k < rows; ++k) {
       t.add(time, false, -1, false);
       time += step + (k == gap_after ? gap : 0.0);
@@ -799,6 +822,19 @@ TEST(TimeGapNote, NamesTheLongestStepWhenItIsAGap) {
   EXPECT_EQ(time_gap_note(tally(12001, 0.001, 5000, 0.02)), "");  // a 21 ms hiccup
   EXPECT_EQ(time_gap_note(tally(100, 0.1, 50, 0.5)), "");         // 10 Hz: 0.6 s is 6 steps
   EXPECT_EQ(time_gap_note(tally(2, 1.0, 0, 5.0)), "");            // too short to tell
+  // Stamped in epoch seconds: the times to the millisecond, not "1.76514e+09" for both.
+  const std::string epoch = time_gap_note(tally(12001, 0.001, 5000, 1.0, 1765140000.0));
+  EXPECT_NE(epoch.find("between t = 1765140005.000 and 1765140006.001 s"), std::string::npos)
+      << epoch;
+}
+
+TEST(TimeText, SixDigitsOrTheMillisecondOfAnEpoch) {
+  EXPECT_EQ(time_text(0.183), "0.183");
+  EXPECT_EQ(time_text(12.3456789), "12.3457");
+  EXPECT_EQ(time_text(-0.0), "0");
+  EXPECT_EQ(time_text(999.5), "999.5");
+  EXPECT_EQ(time_text(1000.0), "1000.000");
+  EXPECT_EQ(time_text(1765140000.9994), "1765140000.999");
 }
 
 // Contacts mostly on link 0 alone (a base sensor read with flipped signs, a wrong pose or bias)

@@ -318,9 +318,10 @@ TEST(Simulator, JointTorqueModelAddsFrictionOffsetsAndNoiseToTheLogOnly) {
     q_prev = sa.q;
     first = false;
   }
-  // Noise only: zero mean, the configured spread, per joint.
+  // Noise only: zero mean, each joint's own spread (0.02, 0.04, ... N m), one quiet joint.
   SimulationConfig noisy = plain;
-  noisy.joint_torque.noise = 0.05;
+  noisy.joint_torque.noise = VectorX::LinSpaced(n, 0.02, 0.02 * n);
+  noisy.joint_torque.noise[n - 1] = 0.0;
   Simulator c(model, ComputedTorqueController(model, small_sinusoid(n), gains), plain);
   Simulator d(model, ComputedTorqueController(model, small_sinusoid(n), gains), noisy);
   VectorX sum = VectorX::Zero(n), sum2 = VectorX::Zero(n);
@@ -334,9 +335,15 @@ TEST(Simulator, JointTorqueModelAddsFrictionOffsetsAndNoiseToTheLogOnly) {
   }
   for (int i = 0; i < n; ++i) {
     const double mean = sum[i] / count, sd = std::sqrt(sum2[i] / count - mean * mean);
-    EXPECT_NEAR(mean, 0.0, 5 * 0.05 / std::sqrt(count));
-    EXPECT_NEAR(sd, 0.05, 5 * 0.05 / std::sqrt(2 * count));
+    const double sigma = noisy.joint_torque.noise[i];
+    EXPECT_NEAR(mean, 0.0, 5 * sigma / std::sqrt(count) + 1e-12) << "joint " << i + 1;
+    EXPECT_NEAR(sd, sigma, 5 * sigma / std::sqrt(2 * count) + 1e-12) << "joint " << i + 1;
   }
+  SimulationConfig wrong_size = plain;
+  wrong_size.joint_torque.noise = VectorX::Constant(n - 1, 0.05);
+  EXPECT_THROW(
+      Simulator(model, ComputedTorqueController(model, small_sinusoid(n), gains), wrong_size),
+      Error);
   // Bad coefficients name what is wrong.
   SimulationConfig bad = plain;
   bad.joint_torque.friction = JointFriction::none(n);

@@ -1,7 +1,8 @@
-// Time steps: the shortest an estimator accepts, and a log's time column taken as seconds (the
-// one rule by which `estimate` notes a log and `calibrate` refuses it).
+// Time steps: the shortest an estimator accepts, a log's time column taken as seconds (the one
+// rule by which `estimate` notes a log and `calibrate` refuses it), and a time in a message.
 #pragma once
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -29,6 +30,15 @@ inline constexpr double kLongestMeanTimeStep = 0.05;
                 "the samples are %.4g s apart on average (%.3g Hz): t must be in seconds "
                 "(docs/log_format.md)",
                 step, 1.0 / step);
+  return text;
+}
+
+/// A log's time in a message: six significant digits ("0.999", "12.3457"), but to the
+/// millisecond from 1000 s on, where a log is stamped by a clock's epoch ("1765140000.999"; six
+/// digits read "1.76514e+09" for every row of a day).
+[[nodiscard]] inline std::string time_text(double t) {
+  char text[40];
+  std::snprintf(text, sizeof text, std::abs(t) >= 1e3 ? "%.3f" : "%.6g", t == 0.0 ? 0.0 : t);
   return text;
 }
 

@@ -49,12 +49,16 @@ struct EncoderModel {
 /// calibration identifies (docs/calibration.md).
 struct JointTorqueModel {
   std::optional<JointFriction> friction;  ///< none when empty
-  double noise = 0.0;                     ///< σ [N m] ≥ 0, every joint
+  /// σ_i [N m | N] ≥ 0 of white noise per joint (a real arm's wrist is quieter than its
+  /// shoulder: calibrate's noise per joint); empty: none.
+  VectorX noise;
 
   /// Friction or noise set.
-  [[nodiscard]] bool active() const noexcept { return friction.has_value() || noise > 0.0; }
+  [[nodiscard]] bool active() const noexcept {
+    return friction.has_value() || (noise.size() > 0 && (noise.array() > 0.0).any());
+  }
   /// Throws extwrench::Error naming `where` on a friction validate_friction refuses for n
-  /// joints, or σ < 0.
+  /// joints, or a noise of another size than n (or empty), or a σ_i < 0.
   void validate(int n, const std::string& where) const;
 };
 
