@@ -219,6 +219,35 @@ TEST(Urdf, WrittenAnglesAreNeverNegativeZero) {
   EXPECT_EQ(text.find("-0\""), std::string::npos) << text;
 }
 
+// A pose at pitch ±π/2 (a wall-mounted sensor, xacro's exact pi/2) and near it: roll and yaw
+// read each from rounding-sized entries composed back 0.04 rad off (a review's sensor at
+// rpy (0, π/2, 0.7) was estimated with a pose 0.21 rad away). Written and read back, every pose
+// is the same rotation to 1e-14, and the written URDF reloads to the same joint placement.
+TEST(Urdf, WrittenAnglesKeepTheRotationAtAndNearGimbalLock) {
+  const double half_pi = 1.5707963267948966;
+  std::vector<Vector3> poses;
+  for (const double pitch :
+       {half_pi, -half_pi, half_pi - 1e-9, -half_pi + 1e-12, half_pi - 1e-5, 1.3, 0.0, 3.0}) {
+    for (const double roll : {0.0, 0.3, -2.9, 3.1})
+      for (const double yaw : {0.0, 0.2, 0.7, -1.4}) poses.emplace_back(roll, pitch, yaw);
+  }
+  for (const Vector3& rpy : poses) {
+    const Matrix3 r = Pose::from_xyz_rpy(Vector3::Zero(), rpy).rotation;
+    const Vector3 back = rpy_from_rotation(r);
+    const Matrix3 again = Pose::from_xyz_rpy(Vector3::Zero(), back).rotation;
+    EXPECT_LT((again - r).cwiseAbs().maxCoeff(), 1e-14)
+        << rpy.transpose() << " -> " << back.transpose();
+  }
+  Model m = load_robot(test::project_models() / "paper_arm.urdf", no_meshes()).model;
+  m.joints[2].placement.rotation =
+      Pose::from_xyz_rpy(Vector3::Zero(), Vector3(0.3, half_pi, 0.2)).rotation;
+  const Model reread =
+      load_urdf_string(write_urdf_string(m, GeometryModel{}), "written.urdf", no_meshes()).model;
+  EXPECT_LT(
+      (reread.joints[2].placement.rotation - m.joints[2].placement.rotation).cwiseAbs().maxCoeff(),
+      1e-14);
+}
+
 // ---- the shared validation models ------------------------------------------------------------
 
 TEST(Urdf, MjcfOnlyOptionsAreRefusedNamingThem) {

@@ -78,13 +78,22 @@ struct Pose {
   }
 };
 
-/// Rotation matrix to fixed-axis roll, pitch, yaw (URDF convention). Never -0: atan2 of a -0
-/// entry gives -0, which text would carry ("-0") although reading it back gives the same
-/// rotation with a +0 entry, so written poses would not be a fixed point (+ 0.0 makes it +0).
+/// Rotation matrix to fixed-axis roll, pitch, yaw (URDF convention: R = Rz(yaw) Ry(pitch)
+/// Rx(roll)). Roll is read from the middle row of Rz(yaw)ᵀ R, which is Ry(pitch) Rx(roll)'s
+/// (0, cos roll, −sin roll) whatever the pitch, not from R's last row: near pitch = ±π/2 that
+/// row's entries, and the first column's that give yaw, are rounding-sized, and roll and yaw
+/// read each on its own did not compose back to R (a sensor at pitch π/2 written 0.04 rad off).
+/// At the lock itself (the first column's entries below 1e-15, rounding) yaw is 0 and roll takes
+/// the whole turn about the vertical. Never -0: atan2 of a -0 entry gives -0, which text would
+/// carry
+/// ("-0") although reading it back gives the same rotation with a +0 entry, so written poses
+/// would not be a fixed point (+ 0.0 makes it +0).
 inline Vector3 rpy_from_rotation(const Matrix3& r) {
-  const double pitch = std::atan2(-r(2, 0), std::hypot(r(0, 0), r(1, 0)));
-  const double roll = std::atan2(r(2, 1), r(2, 2));
-  const double yaw = std::atan2(r(1, 0), r(0, 0));
+  const double horizontal = std::hypot(r(0, 0), r(1, 0));  // |cos pitch|
+  const double pitch = std::atan2(-r(2, 0), horizontal);
+  const double yaw = horizontal < 1e-15 ? 0.0 : std::atan2(r(1, 0), r(0, 0));
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  const double roll = std::atan2(s * r(0, 2) - c * r(1, 2), c * r(1, 1) - s * r(0, 1));
   return {roll + 0.0, pitch + 0.0, yaw + 0.0};
 }
 
