@@ -10,6 +10,7 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/csv.hpp"
+#include "extwrench/io/number_text.hpp"
 #include "extwrench/io/output_files.hpp"
 
 namespace extwrench::cli {
@@ -24,7 +25,37 @@ struct DynamicsOptions {
   std::vector<std::filesystem::path> package_path;
   std::vector<std::string> lock;
   std::string root_body, tip_body;  ///< MJCF only
+  std::string gravity;              ///< "gx gy gz" in the root frame, or "" for the model's
 };
+
+/// --gravity "gx gy gz" [m/s^2]: three finite numbers (spaces or commas between them).
+Vector3 parse_gravity(const std::string& text) {
+  const auto fail = [&](const std::string& why) {
+    return UsageError("--gravity: " + why + " in '" + text +
+                      "'; expected three numbers \"gx gy gz\" [m/s^2] in the root frame, e.g. "
+                      "--gravity \"0 9.81 0\" for a robot mounted on a wall");
+  };
+  Vector3 g;
+  int count = 0;
+  std::string token;
+  const auto take = [&] {
+    if (token.empty()) return;
+    if (count == 3) throw fail("more than three numbers");
+    const auto value = parse_number(token);
+    if (!value) throw fail("'" + token + "' is not a finite number");
+    g[count++] = *value;
+    token.clear();
+  };
+  for (const char c : text + " ") {
+    if (c == ' ' || c == '\t' || c == ',') {
+      take();
+    } else {
+      token.push_back(c);
+    }
+  }
+  if (count != 3) throw fail(std::to_string(count) + " number" + (count == 1 ? "" : "s"));
+  return g;
+}
 
 /// Columns of the input for an n-joint robot: t, q1..qn, dq1..dqn, ddq1..ddqn.
 std::vector<std::string> state_columns(int n) {
@@ -46,12 +77,15 @@ void run_dynamics(const DynamicsOptions& opt) {
   // Check the command line before any file is touched: a usage error is reported first.
   std::optional<Pose> given_pose;
   if (opt.sensor_pose_given) given_pose = parse_pose(opt.sensor_pose, "--sensor-pose");
+  const std::optional<Vector3> gravity =
+      opt.gravity.empty() ? std::nullopt : std::optional<Vector3>(parse_gravity(opt.gravity));
   const std::filesystem::path out_path(opt.out);
   if (opt.out != "-") check_output_file(out_path, "--out", {opt.robot, opt.in});
 
   // Inverse dynamics needs no geometry: a mesh that cannot be found (package://) is no error here.
   LoadOptions load = robot_load_options(opt.package_path, opt.lock, opt.root_body, opt.tip_body);
   load.load_meshes = false;
+  if (gravity) load.gravity = *gravity;
   const RobotDescription robot = load_robot_file(opt.robot, load);
   const Model& model = robot.model;
   const int n = model.nq();
@@ -149,6 +183,10 @@ void register_dynamics(CLI::App& app) {
              "Pose of the base sensor in the root frame, \"x y z roll pitch yaw\" (m, rad, URDF "
              "rpy). Default: the model's frame 'sensor', else the root link's origin, aligned")
           ->type_name("\"X Y Z R P Y\"");
+  sub->add_option("--gravity", opt->gravity,
+                  "Gravity in the root frame [m/s^2], \"gx gy gz\" (a robot on a wall or a "
+                  "ceiling). Default: the model's, 0 0 -9.81 for a URDF")
+      ->type_name("\"GX GY GZ\"");
   add_package_path_option(*sub, opt->package_path);
   add_lock_option(*sub, opt->lock);
   add_chain_options(*sub, opt->root_body, opt->tip_body);

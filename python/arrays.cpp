@@ -135,6 +135,19 @@ Vector3 read_vector3(const py::handle& obj, const char* name) {
   return v;
 }
 
+py::array_t<double> pose_matrix(const Pose& X) {
+  py::array_t<double> out({4, 4});
+  auto a = out.mutable_unchecked<2>();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) a(i, j) = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) a(i, j) = X.rotation(i, j);
+    a(i, 3) = X.translation[i];
+  }
+  a(3, 3) = 1.0;
+  return out;
+}
+
 Pose read_pose(const py::handle& obj, const char* name) {
   const RealArray a = real_array(obj, name, 2);
   check_shape(a, name, 4, 4);

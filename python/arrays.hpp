@@ -41,6 +41,8 @@ void read_vector(const py::handle& obj, const char* name, Eigen::Index n, Vector
 [[nodiscard]] Vector3 read_vector3(const py::handle& obj, const char* name);
 /// A 4 × 4 homogeneous transform (finite, rotation block orthonormal to 1e-6) as a Pose.
 [[nodiscard]] Pose read_pose(const py::handle& obj, const char* name);
+/// X as a (4, 4) homogeneous transform (read_pose's inverse).
+[[nodiscard]] py::array_t<double> pose_matrix(const Pose& X);
 
 /// "(5,)" / "(5, 3)": the shape of an array in numpy's spelling.
 [[nodiscard]] std::string shape_text(py::ssize_t rows, py::ssize_t cols = -1);

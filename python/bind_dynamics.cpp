@@ -93,6 +93,14 @@ py::array_t<double> jacobian_py(Robot& r, const py::handle& q, const py::object&
   return to_numpy(r.data->J);
 }
 
+py::array_t<double> frame_pose_py(Robot& r, const py::handle& q, const py::object& frame) {
+  read_vector(q, "q", r.nq(), r.q);
+  forward_poses(r.model(), *r.data, r.q);
+  if (const auto f = frame_not_body(r.model(), frame))
+    return pose_matrix(frame_pose(r.model(), *r.data, *f));
+  return pose_matrix(r.data->X_WB[static_cast<std::size_t>(r.body(frame, "frame"))]);
+}
+
 py::array_t<double> forward_dynamics_py(Robot& r, const py::handle& q, const py::handle& dq,
                                         const py::handle& tau) {
   read_vector(q, "q", r.nq(), r.q);
@@ -186,6 +194,9 @@ point_W: (3,) the point in W (default: the origin of the body, or of the frame n
 velocity, J_w the body's angular velocity, both in world-aligned axes.)");
   m.def("forward_kinematics", &forward_kinematics_py, py::arg("robot"), py::arg("q"),
         "Poses X_WB of every body, (n + 1, 4, 4) homogeneous transforms (body 0 = link 0).");
+  m.def("frame_pose", &frame_pose_py, py::arg("robot"), py::arg("q"), py::arg("frame"),
+        R"(Pose X_WF (4, 4) of a frame (a tool frame, a link merged into its parent, an MJCF body's
+own frame) or of a body, by name or body index, in the world frame W (Pinocchio's oMf).)");
   m.def("forward_dynamics", &forward_dynamics_py, py::arg("robot"), py::arg("q"), py::arg("dq"),
         py::arg("tau"), "Joint accelerations ddq = B^-1 (tau - c(q, dq)), (n,).");
   m.def("sensor_reading", &sensor_reading_py, py::arg("robot"), py::arg("q"), py::arg("dq"),

@@ -51,19 +51,6 @@ int Robot::body(const py::handle& body_or_name, const char* argument) const {
 
 namespace {
 
-py::array_t<double> pose_matrix(const Pose& X) {
-  py::array_t<double> out({4, 4});
-  auto a = out.mutable_unchecked<2>();
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) a(i, j) = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) a(i, j) = X.rotation(i, j);
-    a(i, 3) = X.translation[i];
-  }
-  a(3, 3) = 1.0;
-  return out;
-}
-
 VectorX limits(const Robot& r, double Joint::*field) {
   VectorX v(r.nq());
   for (int i = 0; i < r.nq(); ++i) v[i] = r.model().joints[static_cast<std::size_t>(i) + 1].*field;

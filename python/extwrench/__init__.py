@@ -28,6 +28,7 @@ from ._extwrench import (  # noqa: F401  (re-exported)
     crba,
     forward_dynamics,
     forward_kinematics,
+    frame_pose,
     gravity,
     jacobian,
     load_robot,
@@ -46,9 +47,9 @@ gravity_torques = gravity
 __all__ = [
     "ContactEstimator", "Error", "Estimate", "ExternalWrench", "Robot", "__version__", "bias",
     "EstimateWarning", "bias_torques", "calibrate", "contact_summary", "coriolis_matrix", "crba",
-    "estimate", "forward_dynamics",
-    "forward_kinematics", "gravity", "gravity_torques", "jacobian", "load_robot", "metrics",
-    "read_log", "rnea", "sensor_reading", "simulate", "write_estimates",
+    "estimate", "forward_dynamics", "forward_kinematics", "frame_pose", "gravity",
+    "gravity_torques", "jacobian", "load_robot", "metrics", "read_log", "rnea", "sensor_reading",
+    "simulate", "write_estimates",
 ]
 
 _AXES = ("x", "y", "z")

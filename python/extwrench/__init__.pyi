@@ -17,6 +17,7 @@ from ._extwrench import (
     crba as crba,
     forward_dynamics as forward_dynamics,
     forward_kinematics as forward_kinematics,
+    frame_pose as frame_pose,
     gravity as gravity,
     jacobian as jacobian,
     load_robot as load_robot,

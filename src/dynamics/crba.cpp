@@ -170,6 +170,8 @@ const MatrixX& crba(const Model& model, Data& data, const Eigen::Ref<const Vecto
 
 bool forward_dynamics(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                       const Eigen::Ref<const VectorX>& dq, const Eigen::Ref<const VectorX>& tau) {
+  detail::check_data("forward_dynamics", model, data);
+  detail::check_joint_vector("forward_dynamics", "q", q.size(), model);
   detail::check_joint_vector("forward_dynamics", "dq", dq.size(), model);
   detail::check_joint_vector("forward_dynamics", "tau", tau.size(), model);
   forward_kinematics(model, data, q);

@@ -41,6 +41,11 @@ void world_mass_properties(const Model& model, Data& data) {
 }
 
 Pose frame_pose(const Model& model, const Data& data, int frame) {
+  detail::check_data("frame_pose", model, data);
+  if (frame < 0 || frame >= static_cast<int>(model.frames.size())) [[unlikely]]
+    detail::argument_error("frame_pose", "frame " + std::to_string(frame) +
+                                             " is not a frame of the model (0.." +
+                                             std::to_string(model.frames.size() - 1) + ")");
   const Frame& fr = model.frames[static_cast<std::size_t>(frame)];
   return data.X_WB[fr.body] * fr.placement;
 }

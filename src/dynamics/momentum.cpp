@@ -1,5 +1,6 @@
 #include "extwrench/dynamics/momentum.hpp"
 
+#include "argument_checks.hpp"
 #include "spatial.hpp"
 
 namespace extwrench {
@@ -189,11 +190,17 @@ void momentum_pass(const Model& model, Data& data, const Eigen::Ref<const Vector
 
 void momentum_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                     const Eigen::Ref<const VectorX>& dq) {
+  detail::check_data("momentum_terms", model, data);
+  detail::check_joint_vector("momentum_terms", "q", q.size(), model);
+  detail::check_joint_vector("momentum_terms", "dq", dq.size(), model);
   momentum_pass<false>(model, data, q, dq);
 }
 
 void momentum_and_bias_terms(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                              const Eigen::Ref<const VectorX>& dq) {
+  detail::check_data("momentum_and_bias_terms", model, data);
+  detail::check_joint_vector("momentum_and_bias_terms", "q", q.size(), model);
+  detail::check_joint_vector("momentum_and_bias_terms", "dq", dq.size(), model);
   momentum_pass<true>(model, data, q, dq);
 }
 

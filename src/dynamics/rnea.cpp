@@ -371,6 +371,8 @@ const VectorX& gravity_torques(const Model& model, Data& data, const Eigen::Ref<
 
 const MatrixX& coriolis_matrix(const Model& model, Data& data, const Eigen::Ref<const VectorX>& q,
                                const Eigen::Ref<const VectorX>& dq) {
+  detail::check_data("coriolis_matrix", model, data);
+  detail::check_joint_vector("coriolis_matrix", "q", q.size(), model);
   detail::check_joint_vector("coriolis_matrix", "dq", dq.size(), model);
   forward_kinematics(model, data, q);
   const int nb = model.num_bodies();

@@ -121,6 +121,8 @@ ContactEstimator::ContactEstimator(Model model, GeometryModel geometry, Estimato
 Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
                                const Eigen::Ref<const VectorX>& dq,
                                const Eigen::Ref<const VectorX>& tau) noexcept {
+  // A moved-from estimator has no model left (nq -1): nothing to start (it crashed).
+  if (model_.nq() != n_) return {StatusCode::kNotInitialized, Channel::kNone, -1};
   const Status s = observer_.reset(model_, data_, t, q, dq, tau);
   if (!s.ok()) return s;
   if (options_.drift && observer_.friction().offset != initial_offset_) {
@@ -146,6 +148,8 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
   if (options_.sensor.tare_samples > 0) {
     tare_.bias_S.setZero();
     tare_.request(options_.sensor.tare_samples);
+  } else {
+    tare_.request(0);  // a requested tare not finished: its samples were of the previous run
   }
   // Nothing of the previous run's estimate stays in result(): as a fresh estimator's after its
   // first reset (no estimate yet, r = 0).
@@ -161,6 +165,7 @@ Status ContactEstimator::reset(double t, const Eigen::Ref<const VectorX>& q,
 }
 
 void ContactEstimator::apply_payload(int body, const Inertia* payload) noexcept {
+  if (model_.nq() != n_) return;  // moved from: no model left
   if (payload_body_ >= 0) {
     const auto p = static_cast<std::size_t>(payload_body_);
     model_.bodies[p].inertia = nominal_inertia_[p];
@@ -175,6 +180,7 @@ void ContactEstimator::apply_payload(int body, const Inertia* payload) noexcept 
 }
 
 Status ContactEstimator::set_payload(int body, const Inertia& payload) noexcept {
+  if (model_.nq() != n_) return {StatusCode::kNotInitialized, Channel::kNone, -1};
   if (body < 0 || body >= model_.num_bodies())
     return {StatusCode::kWrongSize, Channel::kNone, body};
   if (!finite_inertia(payload)) return {StatusCode::kNonFinite, Channel::kNone, body};
@@ -379,7 +385,7 @@ Status ContactEstimator::update_with(double t, const Eigen::Ref<const VectorX>& 
   Status s = Status::success();
   if (model_.nq() != n_) {  // moved from: no model left
     s = {StatusCode::kNotInitialized, Channel::kNone, -1};
-  } else if (!std::isfinite(t)) {
+  } else if (!usable_time(t)) {
     s = {StatusCode::kNonFinite, Channel::kTime, 0};
   } else if (initialized_ && !(t - t_ >= kShortestTimeStep)) {
     s = {StatusCode::kNonIncreasingTime, Channel::kTime, 0};

@@ -184,6 +184,9 @@ class UrdfParser {
       const auto locked = options.locked_joints.find(leader);
       if (locked == options.locked_joints.end() || options.locked_joints.count(follower) != 0)
         continue;
+      // A leader locked outside its limits is that error (the builder's), not advice to lock the
+      // follower at a value derived from it (a review's finger at 0.5 of [0, 0.04]).
+      if (outside_limits(robot, leader, locked->second)) continue;
       const double value = number(mimic, "multiplier", owner, 1.0) * locked->second +
                            number(mimic, "offset", owner, 0.0);
       char shown[32];  // as a user would type it (0.3, not 0.30000000000000004)
@@ -192,6 +195,25 @@ class UrdfParser {
            "follows joint '" + leader + "' (<mimic>), which is locked: lock it too, at " +
                std::string(shown) + " (--lock " + follower + "=" + shown + ")");
     }
+  }
+
+  // Whether `value` lies outside the <limit> of the joint named `name` (a joint without one, or
+  // continuous, has none to lie outside of).
+  bool outside_limits(const XMLElement* robot, const std::string& name, double value) const {
+    for (const XMLElement* e = robot->FirstChildElement("joint"); e != nullptr;
+         e = e->NextSiblingElement("joint")) {
+      const char* joint = e->Attribute("name");
+      if (joint == nullptr || name != joint) continue;
+      const char* type = e->Attribute("type");
+      const XMLElement* limit = e->FirstChildElement("limit");
+      if (limit == nullptr || (type != nullptr && std::string(type) == "continuous")) return false;
+      const auto lower = parse_number(limit->Attribute("lower") ? limit->Attribute("lower") : "0",
+                                      kUrdfNumber);
+      const auto upper = parse_number(limit->Attribute("upper") ? limit->Attribute("upper") : "0",
+                                      kUrdfNumber);
+      return lower && upper && !(value >= *lower && value <= *upper);
+    }
+    return false;
   }
 
   double number(const XMLElement* e, const char* attr, const std::string& owner,

@@ -115,10 +115,20 @@ void MomentumObserver::reanchor(const Model& model, Data& data) noexcept {
   gamma_prev_ = gamma_;
 }
 
+// A model or workspace of another size than the observer's: the momentum pass wrote past the
+// workspace's arrays and returned ok (rnea throws on it; these are noexcept). Sizes only, as
+// rnea's check_data: Data::matches also compares the inertias its rnea caches, which a payload
+// changes in the estimator's model without concerning the momentum pass.
+bool MomentumObserver::sized_for(const Model& model, const Data& data) const noexcept {
+  return model.nq() == n_ && static_cast<int>(data.X_WB.size()) == model.num_bodies() &&
+         data.momentum.size() == n_;
+}
+
 Status MomentumObserver::reset(const Model& model, Data& data, double t,
                                const Eigen::Ref<const VectorX>& q,
                                const Eigen::Ref<const VectorX>& dq) noexcept {
-  if (!std::isfinite(t)) return {StatusCode::kNonFinite, Channel::kTime, 0};
+  if (!sized_for(model, data)) return {StatusCode::kWrongSize, Channel::kNone, -1};
+  if (!usable_time(t)) return {StatusCode::kNonFinite, Channel::kTime, 0};
   if (Status s = check_vector(q, n_, Channel::kPosition); !s.ok()) return s;
   if (Status s = check_vector(dq, n_, Channel::kVelocity); !s.ok()) return s;
   // m = B q̇, Cᵀq̇ and g in one O(n) pass (eq. 4).
@@ -153,7 +163,7 @@ Status MomentumObserver::validate(double t, const Eigen::Ref<const VectorX>& q,
                                   const Eigen::Ref<const VectorX>& dq,
                                   const Eigen::Ref<const VectorX>& tau) const noexcept {
   if (!initialized_) return {StatusCode::kNotInitialized, Channel::kNone, -1};
-  if (!std::isfinite(t)) return {StatusCode::kNonFinite, Channel::kTime, 0};
+  if (!usable_time(t)) return {StatusCode::kNonFinite, Channel::kTime, 0};
   if (!(t - t_ >= kShortestTimeStep)) return {StatusCode::kNonIncreasingTime, Channel::kTime, 0};
   if (Status s = check_vector(q, n_, Channel::kPosition); !s.ok()) return s;
   if (Status s = check_vector(dq, n_, Channel::kVelocity); !s.ok()) return s;
@@ -165,6 +175,7 @@ Status MomentumObserver::update(const Model& model, Data& data, double t,
                                 const Eigen::Ref<const VectorX>& dq,
                                 const Eigen::Ref<const VectorX>& tau) noexcept {
   // Every input is checked before any state changes: a bad sample leaves no trace.
+  if (!sized_for(model, data)) return {StatusCode::kWrongSize, Channel::kNone, -1};
   if (Status s = validate(t, q, dq, tau); !s.ok()) return s;
   momentum_terms(model, data, q, dq);  // m = B q̇, Cᵀq̇ and g in one O(n) pass (eq. 4)
   integrate(data, t, q, dq, tau);

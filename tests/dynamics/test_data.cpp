@@ -7,6 +7,7 @@
 #include "extwrench/dynamics/crba.hpp"
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/kinematics.hpp"
+#include "extwrench/dynamics/momentum.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/model/sample_models.hpp"
 
@@ -56,6 +57,21 @@ TEST(DynamicsArguments, WrongSizesBodiesAndWorkspacesAreErrorsNamingThem) {
   Matrix6X J(6, 5);
   EXPECT_EQ(message([&] { point_jacobian(model, data, 3, Vector3::Zero(), J); }),
             "point_jacobian: J has 5 columns, the model has 6 joints");
+  // A review: these named forward_kinematics, read past the frames, or wrote past the arrays.
+  EXPECT_EQ(message([&] { (void)forward_dynamics(model, data, short_q, z, z); }),
+            "forward_dynamics: q has 5 entries, the model has 6 joints");
+  EXPECT_EQ(message([&] { (void)coriolis_matrix(model, data, short_q, z); }),
+            "coriolis_matrix: q has 5 entries, the model has 6 joints");
+  const int frames = static_cast<int>(model.frames.size());
+  EXPECT_EQ(message([&] { (void)frame_pose(model, data, frames); }),
+            "frame_pose: frame " + std::to_string(frames) + " is not a frame of the model (0.." +
+                std::to_string(frames - 1) + ")");
+  EXPECT_EQ(message([&] { (void)frame_pose(model, data, -1); }).rfind("frame_pose: frame -1 ", 0),
+            0u);
+  EXPECT_EQ(message([&] { momentum_terms(model, other_data, z, z); }),
+            "momentum_terms: data was made for another model (8 bodies, the model has 7)");
+  EXPECT_EQ(message([&] { momentum_and_bias_terms(model, data, z, short_q); }),
+            "momentum_and_bias_terms: dq has 5 entries, the model has 6 joints");
   // The right sizes pass.
   EXPECT_EQ(message([&] { (void)rnea(model, data, z, z, z); }), "no error");
 }

@@ -145,6 +145,15 @@ TEST(LockedJoints, TheFollowerOfALockedMimicLeaderIsNamedWithItsValue) {
           .model.nq(),
       2);
   EXPECT_EQ(load_urdf_string(xml, "mimic.urdf", locks({})).model.nq(), 4);  // no lock: joints
+  // A leader locked outside its limits [0, 0.04] is that error, not advice to lock the follower
+  // at a value derived from it (a review: the Panda's finger at 0.5).
+  const std::string outside = test::error_of([&] {
+    (void)load_urdf_string(xml, "mimic.urdf", locks({{"finger_slide", 0.5}}));
+  });
+  EXPECT_NE(outside.find("locked value 0.5 is outside the joint's limits [0, 0.04]"),
+            std::string::npos)
+      << outside;
+  EXPECT_EQ(outside.find("lock it too"), std::string::npos) << outside;
 }
 
 TEST(LockedJoints, BadLocksAreClearErrors) {

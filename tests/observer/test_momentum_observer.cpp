@@ -130,6 +130,22 @@ TEST(MomentumObserver, UpdateBeforeResetReportsNotInitialized) {
   EXPECT_EQ(obs.update(model, data, 0.1, z, z, z).code, StatusCode::kNotInitialized);
 }
 
+// A workspace or model of another size (a review's 3-joint Data with the 7-joint arm): reset and
+// update returned ok and the momentum pass wrote past the workspace's arrays.
+TEST(MomentumObserver, AWorkspaceOrModelOfAnotherSizeIsWrongSize) {
+  const Model model = test::paper_arm_model();
+  const Model small = random_chain({.n = 3});
+  Data data(model), small_data(small);
+  MomentumObserver obs(model, 100.0);
+  const VectorX z = VectorX::Zero(7);
+  EXPECT_EQ(obs.reset(model, small_data, 0.0, z, z, z).code, StatusCode::kWrongSize);
+  EXPECT_EQ(obs.reset(small, small_data, 0.0, z, z, z).code, StatusCode::kWrongSize);
+  ASSERT_TRUE(obs.reset(model, data, 0.0, z, z, z).ok());
+  EXPECT_EQ(obs.update(model, small_data, 0.001, z, z, z).code, StatusCode::kWrongSize);
+  EXPECT_EQ(obs.update(small, data, 0.001, z, z, z).code, StatusCode::kWrongSize);
+  EXPECT_TRUE(obs.update(model, data, 0.001, z, z, z).ok());
+}
+
 TEST(MomentumObserver, BadInputsNameTheChannelAndIndexAndLeaveTheStateBitIdentical) {
   const Model model = test::paper_arm_model();
   SeededRng rng(3);

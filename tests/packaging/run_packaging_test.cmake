@@ -67,7 +67,7 @@ set(core_only ${WORK_DIR}/core-only)
 file(MAKE_DIRECTORY ${core_only})
 file(WRITE ${core_only}/CMakeLists.txt
      "cmake_minimum_required(VERSION 3.22)\nproject(core_only LANGUAGES CXX)\n"
-     "set(CMAKE_CXX_STANDARD 20)\nadd_subdirectory(${CONSUMER_DIR}/core core)\n")
+     "add_subdirectory(${CONSUMER_DIR}/core core)\n")
 set(disabled "")
 foreach(p yaml-cpp tinyxml2 assimp embree Threads mujoco)
   list(APPEND disabled -DCMAKE_DISABLE_FIND_PACKAGE_${p}=ON)
@@ -77,6 +77,36 @@ run_step("configure the core consumer with only Eigen findable" ${CMAKE_COMMAND}
          -DCMAKE_BUILD_TYPE=Release ${flags} ${disabled})
 run_step("build the core consumer with only Eigen findable" ${CMAKE_COMMAND} --build
          ${core_only}/build)
+# The core consumer with a controller's own flags, against the same library: -march=native (Eigen
+# aligns to 32 bytes with AVX) and, when the library is not sanitized, AddressSanitizer (Eigen
+# then allocates through its own scheme). Both crashed on the library's objects.
+set(flag_sets "-march=native")
+if(NOT SANITIZE)
+  list(APPEND flag_sets "-fsanitize=address")
+endif()
+set(k 0)
+foreach(extra ${flag_sets})
+  math(EXPR k "${k} + 1")
+  set(flagged ${WORK_DIR}/core-flags-${k})
+  file(MAKE_DIRECTORY ${flagged})
+  file(WRITE ${flagged}/CMakeLists.txt
+       "cmake_minimum_required(VERSION 3.22)\nproject(core_flags LANGUAGES CXX)\n"
+       "add_subdirectory(${CONSUMER_DIR}/core core)\n")
+  set(cxx_flags ${extra})
+  set(link_flags "")
+  if(SANITIZE)
+    string(APPEND cxx_flags " -fsanitize=address,undefined")
+    set(link_flags -fsanitize=address,undefined)
+  elseif(extra MATCHES "sanitize")
+    set(link_flags ${extra})
+  endif()
+  run_step("configure the core consumer with ${extra}" ${CMAKE_COMMAND} -S ${flagged}
+           -B ${flagged}/build -DCMAKE_PREFIX_PATH=${prefix} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+           -DCMAKE_BUILD_TYPE=Release "-DCMAKE_CXX_FLAGS=${cxx_flags}"
+           "-DCMAKE_EXE_LINKER_FLAGS=${link_flags}")
+  run_step("build the core consumer with ${extra}" ${CMAKE_COMMAND} --build ${flagged}/build)
+  run_step("core consumer built with ${extra}" ${flagged}/build/core/consumer_core)
+endforeach()
 run_step("io consumer on the installed URDF" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.urdf)
 run_step("io consumer on the installed DH table" ${consumer_build}/io/consumer_io ${prefix}/share/extwrench/models/paper_arm.yaml)
 run_step("app consumer (replay_log)" ${consumer_build}/app/consumer_app ${prefix}/share/extwrench/models/paper_arm.urdf ${WORK_DIR}/app_out)

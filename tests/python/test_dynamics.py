@@ -180,6 +180,36 @@ def test_jacobian_of_a_frame_is_at_the_frame(tmp_path):
         extwrench.jacobian(robot, q, True)
 
 
+def test_frame_pose_is_the_frames_placement_on_its_body(tmp_path):
+    # Pinocchio's oMf, which Python lacked (a review): the tip frame's pose is its body's pose
+    # times the URDF's fixed origin (xyz 0.1 0.2 0.3, rpy 0.3 0 0), its rotation a rotation, and
+    # its origin moves as jacobian(robot, q, 'tip') says (finite differences).
+    path = tmp_path / "two.urdf"
+    path.write_text(TWO_LINKS_AND_A_TIP)
+    robot = extwrench.load_robot(path)
+    lower = robot.bodies.index("lower")
+    q, dq = np.array([0.4, -0.7]), np.array([0.3, -0.5])
+    c, s = np.cos(0.3), np.sin(0.3)
+    placement = np.array([[1, 0, 0, 0.1], [0, c, -s, 0.2], [0, s, c, 0.3], [0, 0, 0, 1.0]])
+    X = extwrench.frame_pose(robot, q, "tip")
+    np.testing.assert_allclose(X, extwrench.forward_kinematics(robot, q)[lower] @ placement,
+                               atol=1e-15)
+    np.testing.assert_allclose(X[:3, :3] @ X[:3, :3].T, np.eye(3), atol=1e-15)
+    h = 1e-6
+    velocity = (extwrench.frame_pose(robot, q + h * dq, "tip")[:3, 3]
+                - extwrench.frame_pose(robot, q - h * dq, "tip")[:3, 3]) / (2 * h)
+    np.testing.assert_allclose(extwrench.jacobian(robot, q, "tip")[:3] @ dq, velocity, atol=1e-8)
+    # A body by name or index is its body pose.
+    np.testing.assert_array_equal(extwrench.frame_pose(robot, q, "lower"),
+                                  extwrench.forward_kinematics(robot, q)[lower])
+    np.testing.assert_array_equal(extwrench.frame_pose(robot, q, np.int64(lower)),
+                                  extwrench.frame_pose(robot, q, "lower"))
+    with pytest.raises(ValueError, match="no body or frame named 'nope'"):
+        extwrench.frame_pose(robot, q, "nope")
+    with pytest.raises(ValueError, match="q"):
+        extwrench.frame_pose(robot, q[:1], "tip")
+
+
 def test_no_reference_leak_over_many_calls(robot):
     n = robot.nq
     q, dq, ddq = np.zeros(n), np.full(n, 0.1), np.zeros(n)

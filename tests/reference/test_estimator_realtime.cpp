@@ -507,6 +507,12 @@ TEST(EstimatorRealTime, RejectedSamplesKeepTheDeclaredContactAndTheClockAndReset
   EXPECT_EQ(big.index, 3);
   ASSERT_TRUE(fresh.update(2e-3, s.q[2], s.dq[2], s.tau[2], s.reading[2]).ok());
   EXPECT_TRUE(fresh.result().residual.allFinite());
+  // A time stamp of DBL_MAX (finite) made the step infinite and the residual non-finite for good
+  // with status ok: refused on the time channel (the sample at 3 ms below goes on as before).
+  const Status far =
+      fresh.update(std::numeric_limits<double>::max(), s.q[2], s.dq[2], s.tau[2], s.reading[2]);
+  EXPECT_EQ(far.code, StatusCode::kNonFinite);
+  EXPECT_EQ(far.channel, Channel::kTime);
   // A NaN sensor bias is refused and leaves the bias as it was.
   const Vector6 bias = fresh.sensor_bias();
   Vector6 nan_bias = Vector6::Zero();
@@ -531,7 +537,22 @@ TEST(EstimatorRealTime, RejectedSamplesKeepTheDeclaredContactAndTheClockAndReset
                              s.reading[2])
                 .code,
             StatusCode::kNotInitialized);
+  // So do its reset and set_payload, and clear_payload does nothing (the three crashed).
+  EXPECT_EQ(fresh.reset(0.0, s.q[0], s.dq[0], s.tau[0]).code,  // NOLINT
+            StatusCode::kNotInitialized);
+  Inertia payload;
+  payload.mass = 1.0;
+  EXPECT_EQ(fresh.set_payload(7, payload).code, StatusCode::kNotInitialized);  // NOLINT
+  fresh.clear_payload();                                                       // NOLINT
   EXPECT_TRUE(moved.update(3e-3, s.q[3], s.dq[3], s.tau[3], s.reading[3]).ok());
+  // A tare requested and not finished does not survive a reset (its samples came before), as a
+  // fresh estimator has none in progress.
+  moved.request_tare(200);
+  ASSERT_TRUE(moved.update(4e-3, s.q[4], s.dq[4], s.tau[4], s.reading[4]).ok());
+  ASSERT_TRUE(moved.result().has(EstimateFlag::kTaring)) << moved.result().flags;
+  ASSERT_TRUE(moved.reset(20.0, s.q[5], s.dq[5], s.tau[5]).ok());
+  ASSERT_TRUE(moved.update(20.001, s.q[6], s.dq[6], s.tau[6], s.reading[6]).ok());
+  EXPECT_FALSE(moved.result().has(EstimateFlag::kTaring)) << moved.result().flags;
 }
 
 TEST(EstimatorRealTime, UpdateFromASampleServesEverySensorTypeBitForBitWithoutAllocation) {

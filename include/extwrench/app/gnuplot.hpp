@@ -28,7 +28,7 @@ class Decimator {
     return static_cast<int>(data_.size() / static_cast<std::size_t>(width_));
   }
   [[nodiscard]] const double* row(int i) const {
-    return data_.data() + static_cast<std::size_t>(i) * width_;
+    return data_.data() + static_cast<std::size_t>(i) * static_cast<std::size_t>(width_);
   }
   /// Writes the rows as whitespace-separated text (NaN as "NaN", which gnuplot skips).
   void write(const std::filesystem::path& path) const;

@@ -52,7 +52,7 @@ struct RunSummary {
   std::filesystem::path figure;
 };
 
-/// Runs the scenario for every seed: DIR (one seed) or DIR/seed_<s> (several) receives
+/// Runs the scenario for every seed: DIR (one seed) or DIR/seed_\<s\> (several) receives
 /// log.csv, model_estimator.urdf, and per scheme <scheme>/config.yaml, estimates.csv,
 /// metrics.json and figures. The estimates come from replaying log.csv through the same code
 /// as `extwrench estimate`, with the configuration read back from <scheme>/config.yaml.

@@ -11,8 +11,9 @@ namespace extwrench {
 enum class StatusCode : std::uint8_t {
   kOk = 0,
   // Input errors: nothing was changed.
-  kWrongSize,          ///< an input vector has the wrong size
-  kNonFinite,          ///< NaN or Inf in an input, or a magnitude above kLargestInput (1e9)
+  kWrongSize,  ///< an input vector has the wrong size
+  kNonFinite,  ///< NaN or Inf in an input, a magnitude above kLargestInput (1e9), a time above 1e12
+               ///< s
   kNonIncreasingTime,  ///< the time stamp did not increase
   kNotInitialized,     ///< reset() was not called
   // Numerical outcomes.

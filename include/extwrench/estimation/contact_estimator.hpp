@@ -45,14 +45,17 @@ class ContactEstimator {
   ContactEstimator(Model model, GeometryModel geometry, EstimatorOptions options);
 
   /// Starts at time t (observer reset, filters and detection cleared, tare restarted if
-  /// configured). τ is the torque held over the first interval.
+  /// configured, a tare requested by request_tare() and not finished dropped: its samples came
+  /// before). τ is the torque held over the first interval. The sensor bias a finished tare or
+  /// set_sensor_bias() gave is kept (with drift tracking, which moves it, it starts again from
+  /// the configured one), as is a payload. kNotInitialized on a moved-from estimator.
   [[nodiscard]] Status reset(double t, const Eigen::Ref<const VectorX>& q,
                              const Eigen::Ref<const VectorX>& dq,
                              const Eigen::Ref<const VectorX>& tau) noexcept;
   /// reset(s.t, s.q, s.dq, s.tau).
   [[nodiscard]] Status reset(const Sample& s) noexcept { return reset(s.t, s.q, s.dq, s.tau); }
 
-  /// One sample of any sensor type: the base reading s.sensor is used when the configured sensor
+  /// One sample of any sensor type: the base reading s.reading_S is used when the configured sensor
   /// needs it, and must then be present (s.has_force, and s.has_moment for an F/T sensor; else
   /// kWrongSize on the base-wrench channel). Returns result().status.
   [[nodiscard]] Status update(const Sample& s) noexcept;
@@ -94,9 +97,9 @@ class ContactEstimator {
   /// Adds a payload (mass properties in the frame of `body`) to body `body` of model(),
   /// replacing any previous payload; the observer is re-anchored so that r stays continuous.
   /// Allocation-free. kWrongSize for a bad body index, kNonFinite for a NaN/Inf entry or a
-  /// negative mass (then nothing changes).
+  /// negative mass, kNotInitialized on a moved-from estimator (then nothing changes).
   [[nodiscard]] Status set_payload(int body, const Inertia& payload) noexcept;
-  /// Removes the payload (same continuity as set_payload).
+  /// Removes the payload (same continuity as set_payload); nothing on a moved-from estimator.
   void clear_payload() noexcept { apply_payload(-1, nullptr); }
 
   /// Pages in the code and data the first contact needs (warm_up_geometry on this estimator's

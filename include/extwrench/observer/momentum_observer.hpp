@@ -66,7 +66,8 @@ class MomentumObserver {
 
   /// Starts (or restarts) the observer at time t: r = 0, m(0) = B(q) q̇ (momentum_terms on
   /// `data`). The torque of the interval [t, t_1) is `tau`; the overload without it takes the
-  /// first update's torque.
+  /// first update's torque. kWrongSize (channel none) for a model of another size than the
+  /// observer's or a `data` of another size than the model, and nothing is changed.
   [[nodiscard]] Status reset(const Model& model, Data& data, double t,
                              const Eigen::Ref<const VectorX>& q,
                              const Eigen::Ref<const VectorX>& dq) noexcept;
@@ -77,8 +78,8 @@ class MomentumObserver {
 
   /// One sample: t > previous t, q, q̇, τ (commanded joint torques) of size n, all finite.
   /// validate(), then momentum_terms(model, data, q, q̇), then integrate(). On an input error the
-  /// Status names the channel and index and nothing is changed (the state stays bit-identical).
-  /// O(n), no allocation.
+  /// Status names the channel and index and nothing is changed (the state stays bit-identical);
+  /// kWrongSize (channel none) for a model or `data` of another size. O(n), no allocation.
   [[nodiscard]] Status update(const Model& model, Data& data, double t,
                               const Eigen::Ref<const VectorX>& q,
                               const Eigen::Ref<const VectorX>& dq,
@@ -122,6 +123,8 @@ class MomentumObserver {
   [[nodiscard]] int nq() const noexcept { return n_; }
 
  private:
+  /// The model has the observer's n joints and `data` its size (see reset).
+  [[nodiscard]] bool sized_for(const Model& model, const Data& data) const noexcept;
   /// τ_f(q̇) and γ = Cᵀq̇ − g − τ_f from the momentum terms in `data`.
   void integrand(const Data& data, const Eigen::Ref<const VectorX>& dq) noexcept;
   /// m_prev_ = data.momentum + δI q̇: the momentum of a new anchor sample.
