@@ -222,7 +222,7 @@ bool has_defect(const ContactEstimator& e, const Decoded& s, double t_last) {
   const int n = e.model().nq();
   const SensorType type = e.options().sensor.type;
   if (type != SensorType::kNone && s.mode != ReadingMode::kGiven) return true;
-  if (!std::isfinite(s.t) || !(s.t - t_last >= kShortestTimeStep)) return true;
+  if (!usable_time(s.t) || !(s.t - t_last >= kShortestTimeStep)) return true;
   for (const VectorX* v : {&s.q, &s.dq, &s.tau}) {
     if (v->size() != n) return true;
     for (Eigen::Index i = 0; i < n; ++i)
@@ -247,7 +247,7 @@ bool blame_is_right(const ContactEstimator& e, const Decoded& s, Status status, 
       if (status.channel == Channel::kBaseWrench) return s.mode != ReadingMode::kGiven;
       return v != nullptr && v->size() != n;
     case StatusCode::kNonFinite:
-      if (status.channel == Channel::kTime) return !std::isfinite(s.t);
+      if (status.channel == Channel::kTime) return !usable_time(s.t);
       if (status.channel == Channel::kBaseWrench)
         return status.index >= 0 && status.index < 6 && !usable_input(s.reading_S[status.index]);
       return v != nullptr && status.index >= 0 && status.index < v->size() &&
