@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
@@ -38,6 +39,13 @@ void register_calibrate(CLI::App& app);
 inline constexpr const char* kRobotFileHelp =
     "Robot file: URDF (.urdf, .xml), DH table (.yaml, .yml) or MJCF (.xml, .mjcf with root "
     "<mujoco>, when built with MuJoCo)";
+
+/// The numbers of an option's value, separated by spaces, tabs or commas, at most `most` of them
+/// (`most_words`: "six"). Throws fail("'x' is not a finite number") or fail("more than six
+/// numbers"); the caller checks how many it needs.
+[[nodiscard]] std::vector<double> parse_numbers(
+    const std::string& text, std::size_t most, const char* most_words,
+    const std::function<UsageError(const std::string&)>& fail);
 
 /// "x y z roll pitch yaw" (metres, radians; URDF's fixed-axis rpy; spaces or commas between
 /// the six numbers) as a Pose. Throws UsageError naming `option` otherwise.

@@ -16,21 +16,16 @@
 
 namespace extwrench::cli {
 
-Pose parse_pose(const std::string& text, const std::string& option) {
-  const auto fail = [&](const std::string& why) -> UsageError {
-    return UsageError(option + ": " + why + " in '" + text +
-                      "'; expected six numbers \"x y z roll pitch yaw\" (metres, radians), "
-                      "e.g. --sensor-pose \"0 0 0.1 0 0 1.5708\"");
-  };
-  std::array<double, 6> values{};
-  std::size_t count = 0;
+std::vector<double> parse_numbers(const std::string& text, std::size_t most, const char* most_words,
+                                  const std::function<UsageError(const std::string&)>& fail) {
+  std::vector<double> values;
   std::string token;
   const auto take = [&]() {
     if (token.empty()) return;
-    if (count == values.size()) throw fail("more than six numbers");
+    if (values.size() == most) throw fail(std::string("more than ") + most_words + " numbers");
     const auto value = parse_number(token);
     if (!value) throw fail("'" + token + "' is not a finite number");
-    values[count++] = *value;
+    values.push_back(*value);
     token.clear();
   };
   for (const char c : text) {
@@ -41,7 +36,17 @@ Pose parse_pose(const std::string& text, const std::string& option) {
     }
   }
   take();
-  if (count != values.size()) throw fail(std::to_string(count) + " number(s)");
+  return values;
+}
+
+Pose parse_pose(const std::string& text, const std::string& option) {
+  const auto fail = [&](const std::string& why) -> UsageError {
+    return UsageError(option + ": " + why + " in '" + text +
+                      "'; expected six numbers \"x y z roll pitch yaw\" (metres, radians), "
+                      "e.g. --sensor-pose \"0 0 0.1 0 0 1.5708\"");
+  };
+  const std::vector<double> values = parse_numbers(text, 6, "six", fail);
+  if (values.size() != 6) throw fail(std::to_string(values.size()) + " number(s)");
   return Pose::from_xyz_rpy(Vector3(values[0], values[1], values[2]),
                             Vector3(values[3], values[4], values[5]));
 }

@@ -10,7 +10,6 @@
 #include "extwrench/dynamics/data.hpp"
 #include "extwrench/dynamics/rnea.hpp"
 #include "extwrench/io/csv.hpp"
-#include "extwrench/io/number_text.hpp"
 #include "extwrench/io/output_files.hpp"
 
 namespace extwrench::cli {
@@ -35,26 +34,9 @@ Vector3 parse_gravity(const std::string& text) {
                       "'; expected three numbers \"gx gy gz\" [m/s^2] in the root frame, e.g. "
                       "--gravity \"0 9.81 0\" for a robot mounted on a wall");
   };
-  Vector3 g;
-  int count = 0;
-  std::string token;
-  const auto take = [&] {
-    if (token.empty()) return;
-    if (count == 3) throw fail("more than three numbers");
-    const auto value = parse_number(token);
-    if (!value) throw fail("'" + token + "' is not a finite number");
-    g[count++] = *value;
-    token.clear();
-  };
-  for (const char c : text + " ") {
-    if (c == ' ' || c == '\t' || c == ',') {
-      take();
-    } else {
-      token.push_back(c);
-    }
-  }
-  if (count != 3) throw fail(std::to_string(count) + " number" + (count == 1 ? "" : "s"));
-  return g;
+  const std::vector<double> g = parse_numbers(text, 3, "three", fail);
+  if (g.size() != 3) throw fail(std::to_string(g.size()) + " number" + (g.size() == 1 ? "" : "s"));
+  return {g[0], g[1], g[2]};
 }
 
 /// Columns of the input for an n-joint robot: t, q1..qn, dq1..dqn, ddq1..ddqn.
